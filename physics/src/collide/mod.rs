@@ -1,0 +1,128 @@
+//! Collision detection: bounds, the broad phase and the SAT narrow phase (SPEC §3.1).
+
+mod broad;
+mod sat;
+
+pub use broad::SweepAndPrune;
+pub use sat::collide_polygons;
+
+use crate::body::{Body, BodyHandle};
+use crate::math::Vec2;
+
+/// An axis-aligned bounding box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub min: Vec2,
+    pub max: Vec2,
+}
+
+impl Aabb {
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.x <= other.max.x
+            && other.min.x <= self.max.x
+            && self.min.y <= other.max.y
+            && other.min.y <= self.max.y
+    }
+
+    pub fn grown(&self, by: f64) -> Aabb {
+        let d = Vec2::new(by, by);
+        Aabb {
+            min: self.min - d,
+            max: self.max + d,
+        }
+    }
+}
+
+/// A body's polygon in world coordinates, cached once per step for the narrow phase.
+#[derive(Debug, Clone, Default)]
+pub struct WorldPolygon {
+    pub vertices: Vec<Vec2>,
+    /// Outward unit normal of the edge from vertex i to vertex i+1.
+    pub normals: Vec<Vec2>,
+}
+
+impl WorldPolygon {
+    /// Refills `self` from `body` without reallocating when the size is unchanged.
+    pub fn update(&mut self, body: &Body) {
+        self.vertices.clear();
+        self.vertices.extend(body.world_vertices());
+        self.normals.clear();
+        let n = self.vertices.len();
+        for i in 0..n {
+            let e = self.vertices[(i + 1) % n] - self.vertices[i];
+            // (e_y, −e_x)/|e| is outward for the positive vertex order (SPEC §3.1).
+            self.normals.push(Vec2::new(e.y, -e.x) / e.norm());
+        }
+    }
+
+    pub fn aabb(&self) -> Aabb {
+        let mut min = self.vertices[0];
+        let mut max = self.vertices[0];
+        for v in &self.vertices[1..] {
+            min = min.inf(v);
+            max = max.sup(v);
+        }
+        Aabb { min, max }
+    }
+}
+
+/// Identifies which features of the two polygons made a contact point, so that a solver can
+/// match points across steps (warm starting) while the same edges stay in touch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct FeatureId(pub u32);
+
+/// One contact point of a manifold.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ContactPoint {
+    /// World position, halfway between the two surfaces.
+    pub position: Vec2,
+    /// Penetration depth: positive when overlapping, negative inside the contact margin.
+    pub depth: f64,
+    pub id: FeatureId,
+}
+
+/// The contact between two bodies: one normal and up to two points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Manifold {
+    pub body_a: BodyHandle,
+    pub body_b: BodyHandle,
+    /// Unit normal pointing from B towards A (SPEC §2.4).
+    pub normal: Vec2,
+    points: [ContactPoint; 2],
+    len: u8,
+}
+
+impl Manifold {
+    pub fn new(body_a: BodyHandle, body_b: BodyHandle, normal: Vec2) -> Self {
+        Self {
+            body_a,
+            body_b,
+            normal,
+            points: [ContactPoint::default(); 2],
+            len: 0,
+        }
+    }
+
+    pub fn push(&mut self, point: ContactPoint) {
+        if (self.len as usize) < self.points.len() {
+            self.points[self.len as usize] = point;
+            self.len += 1;
+        }
+    }
+
+    pub fn points(&self) -> &[ContactPoint] {
+        &self.points[..self.len as usize]
+    }
+
+    pub fn points_mut(&mut self) -> &mut [ContactPoint] {
+        &mut self.points[..self.len as usize]
+    }
+
+    /// The deepest penetration of the manifold.
+    pub fn depth(&self) -> f64 {
+        self.points()
+            .iter()
+            .map(|p| p.depth)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}

@@ -1,0 +1,75 @@
+//! 2D vector helpers in the notation of SPEC §0.
+
+/// A 2D vector (f64).
+pub type Vec2 = nalgebra::Vector2<f64>;
+
+/// Perp-dot product `a ⊗ b = a_x b_y − a_y b_x`, the 2D stand-in for the cross product.
+#[inline]
+pub fn cross(a: Vec2, b: Vec2) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// `a⊥ = (−a_y, a_x)`: `a` turned by +90°.
+#[inline]
+pub fn perp(a: Vec2) -> Vec2 {
+    Vec2::new(-a.y, a.x)
+}
+
+/// `ω × r` for a scalar angular velocity: the velocity of a point at lever arm `r`.
+#[inline]
+pub fn cross_scalar(omega: f64, r: Vec2) -> Vec2 {
+    Vec2::new(-omega * r.y, omega * r.x)
+}
+
+/// A rotation by an angle, stored as its cosine and sine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rot {
+    pub cos: f64,
+    pub sin: f64,
+}
+
+impl Rot {
+    #[inline]
+    pub fn new(angle: f64) -> Self {
+        let (sin, cos) = angle.sin_cos();
+        Self { cos, sin }
+    }
+
+    /// `R(θ)·v`.
+    #[inline]
+    pub fn apply(self, v: Vec2) -> Vec2 {
+        Vec2::new(
+            self.cos * v.x - self.sin * v.y,
+            self.sin * v.x + self.cos * v.y,
+        )
+    }
+
+    /// `R(θ)ᵀ·v`.
+    #[inline]
+    pub fn apply_inverse(self, v: Vec2) -> Vec2 {
+        Vec2::new(
+            self.cos * v.x + self.sin * v.y,
+            -self.sin * v.x + self.cos * v.y,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn perp_dot_matches_perp_then_dot() {
+        let (a, b) = (Vec2::new(1.5, -2.0), Vec2::new(0.25, 3.0));
+        assert_eq!(cross(a, b), perp(a).dot(&b));
+        assert_eq!(cross_scalar(2.0, a), perp(a) * 2.0);
+    }
+
+    #[test]
+    fn rotation_round_trips() {
+        let r = Rot::new(0.7);
+        let v = Vec2::new(3.0, -1.0);
+        assert!((r.apply_inverse(r.apply(v)) - v).norm() < 1e-15);
+        assert!((Rot::new(std::f64::consts::FRAC_PI_2).apply(v) - perp(v)).norm() < 1e-15);
+    }
+}

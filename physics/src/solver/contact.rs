@@ -1,0 +1,100 @@
+//! Contact points as the solvers see them, and the simplest solver: one contact at a time.
+
+use super::SolverBody;
+use crate::collide::FeatureId;
+use crate::math::{Vec2, cross, perp};
+
+/// One contact point between bodies `a` and `b`, with its material and its last impulses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    pub body_a: u32,
+    pub body_b: u32,
+    pub point: Vec2,
+    /// Unit normal from B towards A (SPEC §2.4).
+    pub normal: Vec2,
+    /// Penetration depth (negative inside the contact margin).
+    pub depth: f64,
+    pub id: FeatureId,
+    /// Combined coefficient of restitution e (SPEC §6.4: the minimum of the two).
+    pub restitution: f64,
+    /// Combined friction coefficient μ.
+    pub friction: f64,
+    /// Impulse `j` along `normal` applied to A (and −j to B) by the last solve.
+    pub normal_impulse: f64,
+    /// Impulse `t` along `normal⊥` applied to A (and −t to B) by the last solve.
+    pub tangent_impulse: f64,
+}
+
+impl Contact {
+    pub fn tangent(&self) -> Vec2 {
+        perp(self.normal)
+    }
+
+    /// Velocity of A's point relative to B's, `v_AB` (SPEC eq. 2–3).
+    pub fn relative_velocity(&self, bodies: &[SolverBody]) -> Vec2 {
+        let (a, b) = (&bodies[self.body_a as usize], &bodies[self.body_b as usize]);
+        a.velocity_at(self.point) - b.velocity_at(self.point)
+    }
+
+    /// Velocity change along `d_out` at this contact from a unit impulse along `d_in` at
+    /// `other` (+ on A, − on B): one entry of SPEC's `A_il` with signs (§3.2.2).
+    pub fn coupling(&self, d_out: Vec2, other: &Contact, d_in: Vec2, bodies: &[SolverBody]) -> f64 {
+        let mut sum = 0.0;
+        for (body, s_out) in [(self.body_a, 1.0), (self.body_b, -1.0)] {
+            for (other_body, s_in) in [(other.body_a, 1.0), (other.body_b, -1.0)] {
+                if body == other_body {
+                    let t = &bodies[body as usize];
+                    let r_out = self.point - t.position;
+                    let r_in = other.point - t.position;
+                    sum += s_out
+                        * s_in
+                        * (t.inv_mass * d_out.dot(&d_in)
+                            + t.inv_inertia * cross(r_out, d_out) * cross(r_in, d_in));
+                }
+            }
+        }
+        sum
+    }
+
+    /// Applies `j·n + t·n⊥` to A at the contact point and the opposite to B.
+    pub fn apply(&self, bodies: &mut [SolverBody], normal_impulse: f64, tangent_impulse: f64) {
+        let impulse = self.normal * normal_impulse + self.tangent() * tangent_impulse;
+        bodies[self.body_a as usize].apply_impulse(impulse, self.point);
+        bodies[self.body_b as usize].apply_impulse(-impulse, self.point);
+    }
+}
+
+/// The speed below which contacts do not bounce: resting bodies would otherwise hop on the
+/// velocity gravity adds in one step (SPEC §6.4).
+pub fn restitution_threshold(gravity: Vec2, dt: f64) -> f64 {
+    2.0 * gravity.norm() * dt
+}
+
+/// SPEC §2.4.5's "separated" impulses: each contact alone, once, in order (eq. 15 and
+/// Coulomb friction of §2.4.4). Poor with several contacts — kept as the baseline the
+/// simultaneous solvers are measured against.
+pub fn solve_sequential(contacts: &mut [Contact], bodies: &mut [SolverBody], bounce_below: f64) {
+    for c in contacts.iter_mut() {
+        let v = c.relative_velocity(bodies);
+        let v_n = v.dot(&c.normal);
+        if v_n >= 0.0 {
+            c.normal_impulse = 0.0;
+            c.tangent_impulse = 0.0;
+            continue;
+        }
+        let e = if -v_n < bounce_below {
+            0.0
+        } else {
+            c.restitution
+        };
+        let k_n = c.coupling(c.normal, c, c.normal, bodies);
+        let j = -(1.0 + e) * v_n / k_n;
+        let t_dir = c.tangent();
+        let k_t = c.coupling(t_dir, c, t_dir, bodies);
+        let v_t = v.dot(&t_dir) + j * c.coupling(t_dir, c, c.normal, bodies);
+        let t = (-v_t / k_t).clamp(-c.friction * j, c.friction * j);
+        c.apply(bodies, j, t);
+        c.normal_impulse = j;
+        c.tangent_impulse = t;
+    }
+}

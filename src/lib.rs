@@ -1,0 +1,8 @@
+//! RoboSim: design 2D robots from rigid convex polygons and watch them move.
+//!
+//! `model` and `db` hold the three-file XML database, `sim` turns a scene into a running
+//! `pe::World`, `app` is the editor. Dependencies point one way: app → sim → pe.
+
+pub use pe;
+
+pub mod app;
