@@ -1,6 +1,7 @@
 //! Constraint solvers: contacts, the boxed LCP, joints and motors.
 
 pub mod contact;
+pub mod lcp;
 
 use crate::body::Body;
 use crate::math::{Vec2, cross, cross_scalar};

@@ -1,0 +1,490 @@
+//! A boxed linear complementarity problem solver (SPEC §3.2.4, eq. 32):
+//! given symmetric PSD `A`, `b` and bounds `lo ≤ 0 ≤ hi`, find `x` and `w = A·x + b` with
+//! `lo ≤ x ≤ hi` and, per index, `x = lo, w ≥ 0` or `x = hi, w ≤ 0` or `lo < x < hi, w = 0`.
+//!
+//! The method is Baraff's 1994 pivoting algorithm as the thesis extends it to bounds: drive
+//! one index at a time to complementarity, moving the clamped set `C` (w = 0) along. `A_CC`
+//! is kept as a Cholesky factor updated by one row when an index joins `C` and by Givens
+//! rotations when one leaves, so a pivot costs O(|C|²), not O(|C|³).
+//!
+//! Rows may also be *friction rows* whose bounds are `±μ·x_j` of a normal row `j`
+//! (ODE's "findex"): those are solved by re-solving with bounds from the last normals until
+//! the bounds stop moving (warm-started; a fixed point, usually in 2–4 rounds).
+//!
+//! Everything is scaled symmetrically by `1/√A_ii` first, so mass ratios of 1:1000 and more
+//! give well-conditioned pivots. A pivot cap and a projected Gauss–Seidel fallback make it
+//! always terminate.
+
+/// One problem. `a` is row-major `n×n`.
+#[derive(Debug, Clone, Copy)]
+pub struct LcpProblem<'a> {
+    pub n: usize,
+    pub a: &'a [f64],
+    pub b: &'a [f64],
+    pub lo: &'a [f64],
+    pub hi: &'a [f64],
+    /// Per row: `Some((j, μ))` makes the bounds `±μ·x_j` (then `lo`/`hi` are ignored).
+    pub friction_index: Option<&'a [Option<(usize, f64)>]>,
+}
+
+/// How a problem was solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LcpMethod {
+    #[default]
+    Pivoting,
+    ProjectedGaussSeidel,
+    /// A or b held a non-finite number: x = 0 was returned.
+    Rejected,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LcpStats {
+    pub method: LcpMethod,
+    pub pivots: usize,
+    /// Largest violation of bounds or complementarity, relative to the problem's scale.
+    pub residual: f64,
+}
+
+/// Where an index stands during pivoting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Set {
+    Unprocessed,
+    Lower,
+    Upper,
+    Clamped,
+}
+
+/// Reusable buffers: solving allocates only when a problem is bigger than any before.
+#[derive(Debug, Clone, Default)]
+pub struct LcpSolver {
+    scale: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    x: Vec<f64>,
+    w: Vec<f64>,
+    set: Vec<Set>,
+    /// Indices in `C`, in the order of the factor's rows.
+    clamped: Vec<usize>,
+    /// Cholesky factor of `A_CC` (row-major, `n` columns reserved per row).
+    factor: Vec<f64>,
+    dx: Vec<f64>,
+    dw: Vec<f64>,
+    rhs: Vec<f64>,
+    previous: Vec<f64>,
+}
+
+/// Regularisation added to `A_CC`'s diagonal (after scaling the diagonal is 1): redundant
+/// contacts make `A_CC` singular, and this keeps the factor finite while changing `w` by
+/// at most 1e-12·|x|.
+const REGULARISATION: f64 = 1e-12;
+/// Friction-index rounds before giving up on a fixed point.
+const FRICTION_ROUNDS: usize = 30;
+/// Projected Gauss–Seidel sweeps of the fallback, and the change (in scaled impulse units,
+/// where the diagonal is 1) below which it stops early.
+const PGS_SWEEPS: usize = 200;
+const PGS_TOLERANCE: f64 = 1e-10;
+
+impl LcpSolver {
+    /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
+    pub fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+        self.solve_with(p, x, true)
+    }
+
+    /// Solves by projected Gauss–Seidel only: the iterative fallback for big islands.
+    pub fn solve_iterative(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+        self.solve_with(p, x, false)
+    }
+
+    fn solve_with(&mut self, p: &LcpProblem, x: &mut Vec<f64>, pivoting: bool) -> LcpStats {
+        let n = p.n;
+        x.clear();
+        x.resize(n, 0.0);
+        let finite = |v: &[f64]| v.iter().all(|z| z.is_finite());
+        if !finite(&p.a[..n * n]) || !finite(&p.b[..n]) {
+            return LcpStats {
+                method: LcpMethod::Rejected,
+                pivots: 0,
+                residual: f64::INFINITY,
+            };
+        }
+        self.load_scaled(p);
+        let mut stats = LcpStats::default();
+        // Gauss–Seidel updates friction bounds row by row already; pivoting needs rounds.
+        let has_friction_rows = p
+            .friction_index
+            .is_some_and(|f| f.iter().any(Option::is_some));
+        let rounds = if pivoting && has_friction_rows {
+            FRICTION_ROUNDS
+        } else {
+            1
+        };
+        self.x.clear();
+        self.x.resize(n, 0.0);
+        let mut method = LcpMethod::Pivoting;
+        for _ in 0..rounds {
+            self.previous.clone_from(&self.x);
+            self.update_friction_bounds(p);
+            let ok = pivoting && self.pivot(&mut stats.pivots);
+            if !ok {
+                method = LcpMethod::ProjectedGaussSeidel;
+                self.x.clone_from(&self.previous);
+                self.gauss_seidel(p);
+            }
+            let change = self
+                .x
+                .iter()
+                .zip(&self.previous)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let size = self.x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            if change <= 1e-12 * size.max(1e-300) {
+                break;
+            }
+        }
+        for ((out, scaled), scale) in x.iter_mut().zip(&self.x).zip(&self.scale).take(n) {
+            *out = scaled * scale;
+        }
+        stats.method = method;
+        stats.residual = complementarity_residual(p, x);
+        stats
+    }
+
+    /// Copies the problem scaled by `s_i = 1/√A_ii`: `A' = S A S`, `b' = S b`, `x = S x'`.
+    fn load_scaled(&mut self, p: &LcpProblem) {
+        let n = p.n;
+        self.scale.clear();
+        self.scale.extend((0..n).map(|i| {
+            if p.a[i * n + i] > 0.0 {
+                1.0 / p.a[i * n + i].sqrt()
+            } else {
+                1.0
+            }
+        }));
+        self.a.clear();
+        self.a
+            .extend((0..n * n).map(|k| self.scale[k / n] * p.a[k] * self.scale[k % n]));
+        self.b.clear();
+        self.b.extend((0..n).map(|i| self.scale[i] * p.b[i]));
+        self.lo.clear();
+        self.lo.extend((0..n).map(|i| p.lo[i] / self.scale[i]));
+        self.hi.clear();
+        self.hi.extend((0..n).map(|i| p.hi[i] / self.scale[i]));
+    }
+
+    /// Friction rows take their bounds from the current normal impulses (in scaled units).
+    fn update_friction_bounds(&mut self, p: &LcpProblem) {
+        let Some(index) = p.friction_index else {
+            return;
+        };
+        for (i, f) in index.iter().enumerate().take(p.n) {
+            if let Some((j, mu)) = *f {
+                let bound = mu * (self.x[j] * self.scale[j]).max(0.0) / self.scale[i];
+                self.lo[i] = -bound;
+                self.hi[i] = bound;
+            }
+        }
+    }
+
+    /// Baraff's pivoting on the scaled problem, from x = 0. False if it failed (pivot cap,
+    /// unbounded direction, or a non-finite step).
+    fn pivot(&mut self, pivots: &mut usize) -> bool {
+        let n = self.b.len();
+        self.x.clear();
+        self.x.resize(n, 0.0);
+        self.w.clone_from(&self.b);
+        self.set.clear();
+        self.set.resize(n, Set::Unprocessed);
+        self.clamped.clear();
+        self.factor.clear();
+        self.factor.resize(n * n, 0.0);
+        self.dx.resize(n, 0.0);
+        self.dw.resize(n, 0.0);
+        let cap = 10 * n + 10;
+        for d in 0..n {
+            if self.lo[d] == self.hi[d] {
+                self.x[d] = self.lo[d];
+                self.set[d] = Set::Lower;
+                continue;
+            }
+            if self.w[d] == 0.0 {
+                if !self.join_clamped(d) {
+                    return false;
+                }
+                continue;
+            }
+            if self.x[d] == self.lo[d] && self.w[d] > 0.0 {
+                self.set[d] = Set::Lower;
+                continue;
+            }
+            if self.x[d] == self.hi[d] && self.w[d] < 0.0 {
+                self.set[d] = Set::Upper;
+                continue;
+            }
+            let sigma = if self.w[d] < 0.0 { 1.0 } else { -1.0 };
+            loop {
+                *pivots += 1;
+                if *pivots > cap || !self.direction(d, sigma) {
+                    return false;
+                }
+                match self.max_step(d, sigma) {
+                    None => return false,
+                    Some((s, event)) => {
+                        for i in 0..n {
+                            self.x[i] += s * self.dx[i];
+                            self.w[i] += s * self.dw[i];
+                        }
+                        if !self.apply_event(event) {
+                            return false;
+                        }
+                        if matches!(event, Event::DriveDone(_) | Event::DriveBound(_, _)) {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Δx with Δx_d = σ and Δw_C = 0, and Δw = A·Δx.
+    fn direction(&mut self, d: usize, sigma: f64) -> bool {
+        let n = self.b.len();
+        self.dx.iter_mut().for_each(|v| *v = 0.0);
+        self.dx[d] = sigma;
+        let m = self.clamped.len();
+        self.rhs.clear();
+        self.rhs
+            .extend(self.clamped.iter().map(|&i| -sigma * self.a[i * n + d]));
+        self.solve_factor();
+        for k in 0..m {
+            self.dx[self.clamped[k]] = self.rhs[k];
+        }
+        for i in 0..n {
+            let row = &self.a[i * n..(i + 1) * n];
+            let mut sum = row[d] * sigma;
+            for &j in &self.clamped {
+                sum += row[j] * self.dx[j];
+            }
+            self.dw[i] = sum;
+        }
+        self.dx.iter().all(|v| v.is_finite())
+    }
+
+    /// The largest step along (Δx, Δw) before some index changes set.
+    fn max_step(&self, d: usize, sigma: f64) -> Option<(f64, Event)> {
+        let mut best: Option<(f64, Event)> = None;
+        let mut consider = |s: f64, e: Event| {
+            let s = s.max(0.0);
+            if best.is_none_or(|(b, _)| s < b) {
+                best = Some((s, e));
+            }
+        };
+        if sigma * self.dw[d] > 0.0 {
+            consider(-self.w[d] / self.dw[d], Event::DriveDone(d));
+        }
+        let bound = if sigma > 0.0 { self.hi[d] } else { self.lo[d] };
+        if bound.is_finite() {
+            consider(
+                (bound - self.x[d]) * sigma,
+                Event::DriveBound(d, sigma > 0.0),
+            );
+        }
+        for &i in &self.clamped {
+            if self.dx[i] < 0.0 && self.lo[i].is_finite() {
+                consider(
+                    (self.lo[i] - self.x[i]) / self.dx[i],
+                    Event::Unclamp(i, false),
+                );
+            } else if self.dx[i] > 0.0 && self.hi[i].is_finite() {
+                consider(
+                    (self.hi[i] - self.x[i]) / self.dx[i],
+                    Event::Unclamp(i, true),
+                );
+            }
+        }
+        for i in 0..d {
+            let joins = match self.set[i] {
+                Set::Lower => self.dw[i] < 0.0,
+                Set::Upper => self.dw[i] > 0.0,
+                _ => false,
+            };
+            if joins {
+                consider(-self.w[i] / self.dw[i], Event::Clamp(i));
+            }
+        }
+        best.filter(|(s, _)| s.is_finite())
+    }
+
+    fn apply_event(&mut self, event: Event) -> bool {
+        match event {
+            Event::DriveDone(d) | Event::Clamp(d) => {
+                self.w[d] = 0.0;
+                self.join_clamped(d)
+            }
+            Event::DriveBound(d, upper) => {
+                self.x[d] = if upper { self.hi[d] } else { self.lo[d] };
+                self.set[d] = if upper { Set::Upper } else { Set::Lower };
+                true
+            }
+            Event::Unclamp(i, upper) => {
+                self.x[i] = if upper { self.hi[i] } else { self.lo[i] };
+                self.leave_clamped(i);
+                self.set[i] = if upper { Set::Upper } else { Set::Lower };
+                true
+            }
+        }
+    }
+
+    /// Appends index `j` to `C`: one new row of the Cholesky factor.
+    fn join_clamped(&mut self, j: usize) -> bool {
+        let n = self.b.len();
+        let m = self.clamped.len();
+        for k in 0..m {
+            let mut sum = self.a[self.clamped[k] * n + j];
+            for c in 0..k {
+                sum -= self.factor[m * n + c] * self.factor[k * n + c];
+            }
+            self.factor[m * n + k] = sum / self.factor[k * n + k];
+        }
+        let row_norm: f64 = (0..m).map(|c| self.factor[m * n + c].powi(2)).sum();
+        let pivot = self.a[j * n + j] + REGULARISATION - row_norm;
+        self.factor[m * n + m] = pivot.max(REGULARISATION).sqrt();
+        self.clamped.push(j);
+        self.set[j] = Set::Clamped;
+        self.factor[m * n + m].is_finite()
+    }
+
+    /// Removes index `i` from `C`, restoring the triangular factor by Givens rotations.
+    fn leave_clamped(&mut self, i: usize) {
+        let n = self.b.len();
+        let m = self.clamped.len();
+        let Some(k) = self.clamped.iter().position(|&c| c == i) else {
+            return;
+        };
+        for r in k..m - 1 {
+            for c in 0..m {
+                self.factor[r * n + c] = self.factor[(r + 1) * n + c];
+            }
+        }
+        for c in 0..m {
+            self.factor[(m - 1) * n + c] = 0.0;
+        }
+        self.clamped.remove(k);
+        let m = m - 1;
+        for j in k..m {
+            let (a, b) = (self.factor[j * n + j], self.factor[j * n + j + 1]);
+            let r = a.hypot(b);
+            if r == 0.0 {
+                continue;
+            }
+            let (c, s) = (a / r, b / r);
+            for row in j..m {
+                let (p, q) = (self.factor[row * n + j], self.factor[row * n + j + 1]);
+                self.factor[row * n + j] = c * p + s * q;
+                self.factor[row * n + j + 1] = -s * p + c * q;
+            }
+        }
+        for row in 0..m {
+            self.factor[row * n + m] = 0.0;
+        }
+        for j in 0..m {
+            if self.factor[j * n + j] < 0.0 {
+                for row in j..m {
+                    self.factor[row * n + j] = -self.factor[row * n + j];
+                }
+            }
+        }
+    }
+
+    /// Solves `A_CC z = rhs` in place with the factor.
+    fn solve_factor(&mut self) {
+        let n = self.b.len();
+        let m = self.clamped.len();
+        for r in 0..m {
+            let mut sum = self.rhs[r];
+            for c in 0..r {
+                sum -= self.factor[r * n + c] * self.rhs[c];
+            }
+            self.rhs[r] = sum / self.factor[r * n + r];
+        }
+        for r in (0..m).rev() {
+            let mut sum = self.rhs[r];
+            for c in r + 1..m {
+                sum -= self.factor[c * n + r] * self.rhs[c];
+            }
+            self.rhs[r] = sum / self.factor[r * n + r];
+        }
+    }
+
+    /// Projected Gauss–Seidel on the scaled problem, from the current `x`.
+    fn gauss_seidel(&mut self, p: &LcpProblem) {
+        let n = self.b.len();
+        for _ in 0..PGS_SWEEPS {
+            let mut change: f64 = 0.0;
+            for i in 0..n {
+                if let Some(Some((j, mu))) = p.friction_index.map(|f| f[i]) {
+                    let bound = mu * (self.x[j] * self.scale[j]).max(0.0) / self.scale[i];
+                    self.lo[i] = -bound;
+                    self.hi[i] = bound;
+                }
+                let row = &self.a[i * n..(i + 1) * n];
+                let w: f64 = row.iter().zip(&self.x).map(|(a, x)| a * x).sum::<f64>() + self.b[i];
+                let diagonal = row[i].max(REGULARISATION);
+                let new = (self.x[i] - w / diagonal).clamp(self.lo[i], self.hi[i]);
+                change = change.max((new - self.x[i]).abs());
+                self.x[i] = new;
+            }
+            if change < PGS_TOLERANCE {
+                break;
+            }
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Event {
+    /// The driven index reached w = 0.
+    DriveDone(usize),
+    /// The driven index reached a bound (true: upper).
+    DriveBound(usize, bool),
+    /// A clamped index reached a bound and leaves C.
+    Unclamp(usize, bool),
+    /// An index at a bound reached w = 0 and joins C.
+    Clamp(usize),
+}
+
+/// The largest violation of `lo ≤ x ≤ hi` and of complementarity, relative to
+/// `max|b| + max|A|·max|x|` (the size of the terms that make up `w`).
+pub fn complementarity_residual(p: &LcpProblem, x: &[f64]) -> f64 {
+    let n = p.n;
+    let amax = p.a[..n * n].iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let xmax = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let bmax = p.b[..n].iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let scale = (bmax + amax * xmax).max(1e-300);
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        let w: f64 = (0..n).map(|j| p.a[i * n + j] * x[j]).sum::<f64>() + p.b[i];
+        let (lo, hi) = match p.friction_index.and_then(|f| f[i]) {
+            Some((j, mu)) => (-mu * x[j].max(0.0), mu * x[j].max(0.0)),
+            None => (p.lo[i], p.hi[i]),
+        };
+        let tol = 1e-12 * scale;
+        let bounds = (lo - x[i]).max(x[i] - hi).max(0.0) / scale;
+        // Complementarity: at lo w ≥ 0, at hi w ≤ 0, inside w = 0.
+        let at_lo = (x[i] - lo).abs() <= tol + 1e-12 * lo.abs();
+        let at_hi = (hi - x[i]).abs() <= tol + 1e-12 * hi.abs();
+        let violation = if at_lo && at_hi {
+            0.0
+        } else if at_lo {
+            (-w).max(0.0)
+        } else if at_hi {
+            w.max(0.0)
+        } else {
+            w.abs()
+        };
+        worst = worst.max(bounds).max(violation / scale);
+    }
+    worst
+}
