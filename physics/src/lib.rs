@@ -29,4 +29,6 @@ pub use math::{Rot, Vec2};
 pub use shape::{ConvexPolygon, MassProperties, ShapeError, convex_hull};
 pub use solver::ContactSolver;
 pub use solver::contact::Contact;
-pub use world::{Integrator, StepSettings, World};
+pub use solver::joint::{Joint, JointHandle, JointMotor};
+pub use solver::motor::BodyMotor;
+pub use world::{Integrator, JointDef, JointError, StepSettings, World};

@@ -28,6 +28,13 @@ pub struct Rot {
     pub sin: f64,
 }
 
+impl Default for Rot {
+    /// No rotation.
+    fn default() -> Self {
+        Self { cos: 1.0, sin: 0.0 }
+    }
+}
+
 impl Rot {
     #[inline]
     pub fn new(angle: f64) -> Self {

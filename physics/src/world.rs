@@ -4,6 +4,14 @@ use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
+use crate::solver::joint::{
+    Joint, JointBlockSolver, JointConstraint, JointHandle, JointIterations, JointMotor,
+    JointSolver, velocity_gap_target,
+};
+use crate::solver::motor::BodyMotor;
+use crate::solver::simultaneous::{FrictionModel, IslandReport, SimultaneousSolver};
+use crate::solver::soft::{SoftSettings, SoftStepSolver};
+use crate::solver::system::VelocityTargets;
 use crate::solver::{ContactSolver, SolverBody};
 
 /// How velocities and positions advance over a step.
@@ -24,6 +32,7 @@ pub struct StepSettings {
     pub contact_solver: ContactSolver,
     /// A typical body size in the world's length unit (1 for metre-sized bodies).
     pub length_scale: f64,
+    pub joint_solver: JointSolver,
 }
 
 impl Default for StepSettings {
@@ -32,6 +41,7 @@ impl Default for StepSettings {
             integrator: Integrator::default(),
             contact_solver: ContactSolver::default(),
             length_scale: 1.0,
+            joint_solver: JointSolver::default(),
         }
     }
 }
@@ -42,11 +52,70 @@ impl StepSettings {
         0.02 * self.length_scale
     }
 
+    /// Penetration up to this depth is left alone, so resting contacts stay in touch.
+    pub fn slop(&self) -> f64 {
+        0.005 * self.length_scale
+    }
+
     /// A reference face is swapped for the other body's only when better by this much.
     pub fn tie_tolerance(&self) -> f64 {
         0.001 * self.length_scale
     }
+
+    /// Joint passes stop at a gap of a millionth of a body; the cap bounds the work when a
+    /// badly broken joint cannot close in one step.
+    pub fn joint_iterations(&self, dt: f64) -> JointIterations {
+        JointIterations {
+            position_tolerance: 1e-6 * self.length_scale,
+            velocity_tolerance: 1e-6 * self.length_scale / dt,
+            max_sweeps: 50,
+            max_closing: 0.2 * self.length_scale,
+            broken_gap: 0.01 * self.length_scale,
+        }
+    }
 }
+
+/// A joint to be made: the bodies and the shared world point they pin together.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointDef {
+    pub body_a: BodyHandle,
+    /// `None` pins body A to the static world.
+    pub body_b: Option<BodyHandle>,
+    /// The pin, in world coordinates at the bodies' current placement.
+    pub anchor: Vec2,
+    pub collide_connected: bool,
+    pub motor: Option<JointMotor>,
+}
+
+impl JointDef {
+    pub fn new(body_a: BodyHandle, body_b: Option<BodyHandle>, anchor: Vec2) -> Self {
+        Self {
+            body_a,
+            body_b,
+            anchor,
+            collide_connected: false,
+            motor: None,
+        }
+    }
+}
+
+/// Why a joint cannot be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JointError {
+    #[error("the joint refers to a body that does not exist")]
+    MissingBody,
+    #[error("a joint needs two different bodies")]
+    SameBody,
+    #[error("the joint anchor is not a finite point")]
+    NonFiniteAnchor,
+}
+
+/// Fraction of the excess penetration the split-impulse pass removes per step: all of it
+/// at once overshoots in stacks, where pushes add up along the column.
+const SPLIT_IMPULSE_RATE: f64 = 0.4;
+
+/// At most this many substeps per step (see `World::substeps_for`).
+const MAX_SUBSTEPS: usize = 8;
 
 /// A 2D world of rigid convex bodies.
 #[derive(Debug, Clone, Default)]
@@ -57,6 +126,10 @@ pub struct World {
     pub friction: f64,
     pub settings: StepSettings,
     step_count: u64,
+    joints: Vec<Option<Joint>>,
+    /// Body pairs `(i, j)`, `i < j`, that a joint keeps from colliding; sorted.
+    non_colliding: Vec<(u32, u32)>,
+    body_motors: Vec<(BodyHandle, BodyMotor)>,
     manifolds: Vec<Manifold>,
     contacts: Vec<Contact>,
     scratch: Scratch,
@@ -70,6 +143,17 @@ struct Scratch {
     broad_phase: SweepAndPrune,
     pairs: Vec<(u32, u32)>,
     solver_bodies: Vec<SolverBody>,
+    /// How far each body can move this step.
+    reach: Vec<f64>,
+    /// Velocities before this step's forces, for restitution.
+    start_velocities: Vec<(Vec2, f64)>,
+    /// Poses and velocities at the start of the step, to redo it with finer substeps.
+    saved_state: Vec<(Vec2, f64, Vec2, f64)>,
+    joint_constraints: Vec<JointConstraint>,
+    joint_solver: JointBlockSolver,
+    simultaneous: SimultaneousSolver,
+    soft: SoftStepSolver,
+    accelerations: Vec<(Vec2, f64)>,
 }
 
 impl World {
@@ -107,6 +191,106 @@ impl World {
             .filter_map(|(i, b)| Some((BodyHandle(i as u32), b.as_ref()?)))
     }
 
+    /// Pins two bodies (or one to the world) at `def.anchor`; both body-space anchors are
+    /// derived from that point now.
+    pub fn add_joint(&mut self, def: JointDef) -> Result<JointHandle, JointError> {
+        if !(def.anchor.x.is_finite() && def.anchor.y.is_finite()) {
+            return Err(JointError::NonFiniteAnchor);
+        }
+        if Some(def.body_a) == def.body_b {
+            return Err(JointError::SameBody);
+        }
+        let a = self.body(def.body_a).ok_or(JointError::MissingBody)?;
+        let local_anchor_a = a.to_local(def.anchor);
+        let local_anchor_b = match def.body_b {
+            Some(h) => self
+                .body(h)
+                .ok_or(JointError::MissingBody)?
+                .to_local(def.anchor),
+            None => def.anchor,
+        };
+        self.joints.push(Some(Joint {
+            body_a: def.body_a,
+            body_b: def.body_b,
+            local_anchor_a,
+            local_anchor_b,
+            collide_connected: def.collide_connected,
+            motor: def.motor,
+        }));
+        self.rebuild_collision_filter();
+        Ok(JointHandle((self.joints.len() - 1) as u32))
+    }
+
+    pub fn remove_joint(&mut self, handle: JointHandle) -> Option<Joint> {
+        let removed = self.joints.get_mut(handle.index())?.take();
+        self.rebuild_collision_filter();
+        removed
+    }
+
+    pub fn joint(&self, handle: JointHandle) -> Option<&Joint> {
+        self.joints.get(handle.index())?.as_ref()
+    }
+
+    pub fn joint_mut(&mut self, handle: JointHandle) -> Option<&mut Joint> {
+        self.joints.get_mut(handle.index())?.as_mut()
+    }
+
+    /// Live joints in handle order.
+    pub fn joints(&self) -> impl Iterator<Item = (JointHandle, &Joint)> {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter_map(|(i, j)| Some((JointHandle(i as u32), j.as_ref()?)))
+    }
+
+    /// World positions of a joint's two anchors (equal while the joint holds).
+    pub fn joint_anchors(&self, handle: JointHandle) -> Option<(Vec2, Vec2)> {
+        let j = self.joint(handle)?;
+        let a = self.body(j.body_a)?.to_world(j.local_anchor_a);
+        let b = match j.body_b {
+            Some(h) => self.body(h)?.to_world(j.local_anchor_b),
+            None => j.local_anchor_b,
+        };
+        Some((a, b))
+    }
+
+    /// Distance between a joint's anchors.
+    pub fn joint_gap(&self, handle: JointHandle) -> Option<f64> {
+        self.joint_anchors(handle).map(|(a, b)| (a - b).norm())
+    }
+
+    /// The widest gap of any joint.
+    pub fn max_joint_gap(&self) -> f64 {
+        self.joints()
+            .filter_map(|(h, _)| self.joint_gap(h))
+            .fold(0.0, f64::max)
+    }
+
+    /// Adds a thesis body motor (SPEC §4.4) driving `body`. Returns its index.
+    pub fn add_body_motor(&mut self, body: BodyHandle, motor: BodyMotor) -> usize {
+        self.body_motors.push((body, motor));
+        self.body_motors.len() - 1
+    }
+
+    pub fn body_motors(&self) -> &[(BodyHandle, BodyMotor)] {
+        &self.body_motors
+    }
+
+    fn rebuild_collision_filter(&mut self) {
+        self.non_colliding = self
+            .joints
+            .iter()
+            .flatten()
+            .filter(|j| !j.collide_connected)
+            .filter_map(|j| {
+                let (a, b) = (j.body_a.0, j.body_b?.0);
+                Some((a.min(b), a.max(b)))
+            })
+            .collect();
+        self.non_colliding.sort_unstable();
+        self.non_colliding.dedup();
+    }
+
     pub fn step_count(&self) -> u64 {
         self.step_count
     }
@@ -142,17 +326,255 @@ impl World {
 
     /// Advances the world by `dt`: SPEC §3.4's stages, in order.
     pub fn step(&mut self, dt: f64) {
-        self.integrate_velocities(dt);
-        self.detect_contacts();
-        self.push_apart();
-        self.solve_contacts(dt);
-        self.integrate_positions(dt);
+        if self.settings.contact_solver == ContactSolver::Soft {
+            self.step_soft(dt);
+            return;
+        }
+        self.apply_motor_torques(dt);
+        self.repair_broken_joints(dt);
+        let mut substeps = self.substeps_for(dt);
+        // A joint still broken is being repaired on purpose over several steps; only
+        // joints that should have closed ask for finer substeps.
+        let repairing = self.max_joint_gap() > self.settings.joint_iterations(dt).broken_gap;
+        loop {
+            self.save_state();
+            let h = dt / substeps as f64;
+            for _ in 0..substeps {
+                self.correct_joint_velocities(h);
+                self.integrate_velocities(h);
+                self.detect_contacts(h);
+                self.push_apart();
+                self.solve_constraints(h);
+                self.place_bounces_at_impact(h);
+                self.integrate_positions(h);
+            }
+            // A whip can spin links up within the step; if they now turn too far per
+            // substep, this step's joint prediction was not trustworthy: redo it finer.
+            let mut needed = self.substeps_for(dt);
+            if !repairing && self.max_joint_gap() > 1e-3 * self.settings.length_scale {
+                needed = needed.max(2 * substeps);
+            }
+            if needed <= substeps || substeps >= MAX_SUBSTEPS {
+                break;
+            }
+            self.restore_state();
+            substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
+        }
         self.clear_forces();
         self.step_count += 1;
     }
 
+    fn save_state(&mut self) {
+        let saved = &mut self.scratch.saved_state;
+        saved.clear();
+        saved.extend(self.bodies.iter().map(|b| {
+            b.as_ref().map_or(Default::default(), |b| {
+                (b.position, b.angle, b.velocity, b.angular_velocity)
+            })
+        }));
+    }
+
+    fn restore_state(&mut self) {
+        for (body, &(p, a, v, w)) in self.bodies.iter_mut().zip(&self.scratch.saved_state) {
+            if let Some(b) = body {
+                (b.position, b.angle, b.velocity, b.angular_velocity) = (p, a, v, w);
+            }
+        }
+    }
+
+    /// How many substeps this step needs: the joint prediction (SPEC §3.3) follows each
+    /// jointed body's rotation by ω·h, and past a quarter radian per step that is too far
+    /// from linear for the Newton steps to be trusted (a whipping chain tip turns a radian
+    /// per 1/60 s). Usually 1.
+    fn substeps_for(&self, dt: f64) -> usize {
+        const MAX_TURN: f64 = 0.25;
+        let fastest = self
+            .joints
+            .iter()
+            .flatten()
+            .flat_map(|j| [Some(j.body_a), j.body_b])
+            .flatten()
+            .filter_map(|h| self.body(h))
+            .map(|b| b.angular_velocity.abs())
+            .fold(0.0, f64::max);
+        ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SUBSTEPS)
+    }
+
+    /// A speculative contact that bounces this step reverses while the bodies are still a
+    /// gap g apart, where they have not yet fallen the last g: the rebound keeps
+    /// (1 − e²)·g too much height. Moving the body down by that much (positions only) puts
+    /// the bounce's energy where an impact at the surface would. Only against static
+    /// bodies: between two free bodies the shift would change angular momentum about the
+    /// origin, and exact conservation is worth more there than this O(v·h) height error.
+    fn place_bounces_at_impact(&mut self, dt: f64) {
+        let bounce_below = restitution_threshold(self.gravity, dt);
+        for k in 0..self.contacts.len() {
+            let c = self.contacts[k];
+            let first_of_pair = k == 0 || {
+                let p = &self.contacts[k - 1];
+                (p.body_a, p.body_b) != (c.body_a, c.body_b)
+            };
+            if !first_of_pair {
+                continue;
+            }
+            let pair = self.contacts[k..]
+                .iter()
+                .take_while(|p| (p.body_a, p.body_b) == (c.body_a, c.body_b));
+            let gap = pair
+                .filter(|p| p.depth < 0.0 && p.normal_impulse > 0.0 && p.bounces(dt, bounce_below))
+                .map(|p| (1.0 - p.restitution * p.restitution) * -p.depth)
+                .fold(0.0, f64::max);
+            if gap == 0.0 {
+                continue;
+            }
+            let is_static = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_static);
+            let (moving, direction) = match (is_static(c.body_a), is_static(c.body_b)) {
+                (false, true) => (c.body_a, -c.normal),
+                (true, false) => (c.body_b, c.normal),
+                _ => continue,
+            };
+            if let Some(body) = self.bodies[moving as usize].as_mut() {
+                body.position += direction * gap;
+            }
+        }
+    }
+
+    /// The soft step has its own stage list: forces, contacts found once, then substeps
+    /// that integrate and solve together (see `solver::soft`).
+    fn step_soft(&mut self, dt: f64) {
+        self.apply_motor_torques(dt);
+        self.scratch.start_velocities.clear(); // forces act inside the substeps
+        self.detect_contacts(dt);
+        self.gather_solver_bodies();
+        let s = &mut self.scratch;
+        s.accelerations.clear();
+        s.accelerations.extend(self.bodies.iter().map(|b| match b {
+            Some(b) if !b.is_static() => (
+                self.gravity + b.force * b.inv_mass,
+                b.torque * b.inv_inertia,
+            ),
+            _ => (Vec2::zeros(), 0.0),
+        }));
+        s.accelerations.push((Vec2::zeros(), 0.0));
+        s.soft.step(
+            &SoftSettings::for_length_scale(self.settings.length_scale),
+            &mut s.solver_bodies,
+            &s.accelerations,
+            &mut self.contacts,
+            &mut s.joint_constraints,
+            dt,
+            restitution_threshold(self.gravity, dt),
+        );
+        self.scatter_solver_bodies();
+        self.clear_forces();
+        self.step_count += 1;
+    }
+
+    /// Copies the bodies into the solver array, the static world last, and resolves the
+    /// joints to slots in it.
+    fn gather_solver_bodies(&mut self) {
+        let s = &mut self.scratch;
+        s.solver_bodies.clear();
+        s.solver_bodies.extend(
+            self.bodies
+                .iter()
+                .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
+        );
+        let ground = self.bodies.len() as u32;
+        s.solver_bodies.push(SolverBody::default());
+        s.joint_constraints.clear();
+        for (i, j) in self.joints.iter().enumerate() {
+            let Some(j) = j else { continue };
+            let live = |h: BodyHandle| self.bodies.get(h.index()).is_some_and(Option::is_some);
+            if !live(j.body_a) || !j.body_b.is_none_or(live) {
+                continue;
+            }
+            let mut c = JointConstraint {
+                joint: i as u32,
+                body_a: j.body_a.0,
+                body_b: j.body_b.map_or(ground, |h| h.0),
+                local_anchor_a: j.local_anchor_a,
+                local_anchor_b: j.local_anchor_b,
+                motor: j.motor,
+                gap_target: Vec2::zeros(),
+            };
+            let gap_now = c.predicted_gap(&s.solver_bodies, 0.0);
+            c.gap_target =
+                velocity_gap_target(gap_now, self.settings.joint_iterations(1.0).broken_gap);
+            s.joint_constraints.push(c);
+        }
+    }
+
+    /// Copies solved velocities (and motor impulses) back.
+    fn scatter_solver_bodies(&mut self) {
+        for (body, solved) in self.bodies.iter_mut().zip(&self.scratch.solver_bodies) {
+            if let Some(b) = body {
+                b.velocity = solved.velocity;
+                b.angular_velocity = solved.angular_velocity;
+                b.position = solved.position;
+                b.angle = solved.angle;
+            }
+        }
+        for c in &self.scratch.joint_constraints {
+            if let Some(Some(j)) = self.joints.get_mut(c.joint as usize) {
+                j.motor = c.motor;
+            }
+        }
+    }
+
+    /// Broken joints move towards closing, by positions only.
+    fn repair_broken_joints(&mut self, dt: f64) {
+        if self.joints.is_empty() {
+            return;
+        }
+        self.gather_solver_bodies();
+        let it = self.settings.joint_iterations(dt);
+        let s = &mut self.scratch;
+        s.joint_solver.repair_positions(
+            self.settings.joint_solver,
+            &mut s.joint_constraints,
+            &mut s.solver_bodies,
+            &it,
+        );
+        self.scatter_solver_bodies();
+    }
+
+    /// Stage 1: joints whose anchors drift apart stop drifting (SPEC eq. 40).
+    fn correct_joint_velocities(&mut self, dt: f64) {
+        if self.joints.is_empty() {
+            return;
+        }
+        self.gather_solver_bodies();
+        let it = self.settings.joint_iterations(dt);
+        let s = &mut self.scratch;
+        s.joint_solver.correct_velocities(
+            self.settings.joint_solver,
+            &mut s.joint_constraints,
+            &mut s.solver_bodies,
+            &it,
+        );
+        self.scatter_solver_bodies();
+    }
+
+    /// Stage 2: body motors add their torque (SPEC §4.4).
+    fn apply_motor_torques(&mut self, dt: f64) {
+        for (handle, motor) in self.body_motors.iter_mut() {
+            let Some(Some(b)) = self.bodies.get_mut(handle.index()) else {
+                continue;
+            };
+            b.torque += motor.torque(self.step_count, b.angular_velocity, dt);
+        }
+    }
+
     /// Gravity and accumulated forces change velocities (SPEC §3.4 steps 2–3).
     fn integrate_velocities(&mut self, dt: f64) {
+        self.scratch.start_velocities.clear();
+        self.scratch
+            .start_velocities
+            .extend(self.bodies.iter().map(|b| {
+                b.as_ref()
+                    .map_or((Vec2::zeros(), 0.0), |b| (b.velocity, b.angular_velocity))
+            }));
         for b in self.bodies.iter_mut().flatten() {
             if b.is_static() {
                 continue;
@@ -163,25 +585,34 @@ impl World {
     }
 
     /// Broad phase, then SAT on each candidate pair (SPEC §3.1).
-    fn detect_contacts(&mut self) {
+    ///
+    /// Each body's bounds and contact margin grow by how far it can move this step, so a
+    /// contact is found (as a speculative one) before the bodies meet, however fast.
+    fn detect_contacts(&mut self, dt: f64) {
         let s = &mut self.scratch;
         s.polygons
             .resize_with(self.bodies.len(), WorldPolygon::default);
         s.boxes.clear();
+        s.reach.clear();
         let margin = self.settings.contact_margin();
         for (body, polygon) in self.bodies.iter().zip(s.polygons.iter_mut()) {
+            let reach = body.as_ref().map_or(0.0, |b| {
+                (b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius()) * dt
+            });
+            s.reach.push(reach);
             s.boxes.push(body.as_ref().map(|b| {
                 polygon.update(b);
-                polygon.aabb().grown(0.5 * margin)
+                polygon.aabb().grown(0.5 * margin + reach)
             }));
         }
         let bodies = &self.bodies;
         let is_static = |i: usize| bodies[i].as_ref().is_none_or(Body::is_static);
-        s.broad_phase.pairs(
-            &s.boxes,
-            |i, j| !(is_static(i) && is_static(j)),
-            &mut s.pairs,
-        );
+        let non_colliding = &self.non_colliding;
+        let wanted = |i: usize, j: usize| {
+            !(is_static(i) && is_static(j))
+                && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
+        };
+        s.broad_phase.pairs(&s.boxes, wanted, &mut s.pairs);
         self.manifolds.clear();
         self.contacts.clear();
         let tie = self.settings.tie_tolerance();
@@ -190,7 +621,7 @@ impl World {
             let found = collide_polygons(
                 (a, &s.polygons[i as usize]),
                 (b, &s.polygons[j as usize]),
-                margin,
+                margin + s.reach[i as usize] + s.reach[j as usize],
                 tie,
             );
             if let Some(m) = found {
@@ -204,6 +635,14 @@ impl World {
             };
             let friction =
                 (a.friction.unwrap_or(self.friction) * b.friction.unwrap_or(self.friction)).sqrt();
+            let start = &self.scratch.start_velocities;
+            let approach = |h: BodyHandle, body: &Body, point: Vec2| {
+                let (v, w) = start
+                    .get(h.index())
+                    .copied()
+                    .unwrap_or((body.velocity, body.angular_velocity));
+                (v + crate::math::cross_scalar(w, point - body.position)).dot(&m.normal)
+            };
             for p in m.points() {
                 self.contacts.push(Contact {
                     body_a: m.body_a.0,
@@ -214,6 +653,10 @@ impl World {
                     id: p.id,
                     restitution: a.restitution.min(b.restitution),
                     friction,
+                    approach_velocity: approach(m.body_a, a, p.position)
+                        - approach(m.body_b, b, p.position),
+                    normal_velocity: (a.velocity_at(p.position) - b.velocity_at(p.position))
+                        .dot(&m.normal),
                     normal_impulse: 0.0,
                     tangent_impulse: 0.0,
                 });
@@ -224,6 +667,9 @@ impl World {
     /// The thesis removes overlap directly: each pair is pushed apart along its normal by
     /// its depth, shared by inverse mass (SPEC §3.1). Positions only.
     fn push_apart(&mut self) {
+        if self.settings.contact_solver == ContactSolver::Exact {
+            return; // the exact solver removes depth by split impulses instead
+        }
         for m in &self.manifolds {
             let depth = m.depth();
             if depth <= 0.0 {
@@ -245,26 +691,66 @@ impl World {
         }
     }
 
-    fn solve_contacts(&mut self, dt: f64) {
+    /// Stages 5–6: contact impulses (with pins and motors in the exact solver), then joint
+    /// position prediction, then (exact solver) the split-impulse depth correction.
+    fn solve_constraints(&mut self, dt: f64) {
+        self.gather_solver_bodies();
         let s = &mut self.scratch;
-        s.solver_bodies.clear();
-        s.solver_bodies.extend(
-            self.bodies
-                .iter()
-                .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
-        );
-        let bounce_below = restitution_threshold(self.gravity, dt);
-        match self.settings.contact_solver {
-            ContactSolver::Sequential | ContactSolver::Thesis => {
-                solve_sequential(&mut self.contacts, &mut s.solver_bodies, bounce_below)
+        let targets = VelocityTargets {
+            dt,
+            bounce_below: restitution_threshold(self.gravity, dt),
+            friction: true,
+            close_joint_gaps: true,
+        };
+        let solver = self.settings.contact_solver;
+        match solver {
+            ContactSolver::Sequential | ContactSolver::Soft => solve_sequential(
+                &mut self.contacts,
+                &mut s.solver_bodies,
+                targets.bounce_below,
+            ),
+            ContactSolver::Thesis | ContactSolver::Exact => {
+                let model = if solver == ContactSolver::Thesis {
+                    FrictionModel::TwoStage
+                } else {
+                    FrictionModel::Coupled
+                };
+                s.simultaneous.solve(
+                    model,
+                    &mut self.contacts,
+                    &mut s.joint_constraints,
+                    &mut s.solver_bodies,
+                    &targets,
+                );
             }
         }
-        for (body, solved) in self.bodies.iter_mut().zip(&s.solver_bodies) {
-            if let Some(b) = body {
-                b.velocity = solved.velocity;
-                b.angular_velocity = solved.angular_velocity;
-            }
+        if !s.joint_constraints.is_empty() {
+            let it = self.settings.joint_iterations(dt);
+            s.joint_solver.correct_positions(
+                self.settings.joint_solver,
+                &mut s.joint_constraints,
+                &mut s.solver_bodies,
+                dt,
+                &it,
+                solver == ContactSolver::Exact,
+            );
         }
+        if solver == ContactSolver::Exact {
+            s.simultaneous.separate(
+                &self.contacts,
+                &s.joint_constraints,
+                &mut s.solver_bodies,
+                dt,
+                self.settings.slop(),
+                SPLIT_IMPULSE_RATE,
+            );
+        }
+        self.scatter_solver_bodies();
+    }
+
+    /// How each island was solved in the last step (simultaneous solvers only).
+    pub fn island_reports(&self) -> &[IslandReport] {
+        &self.scratch.simultaneous.reports
     }
 
     /// Positions follow velocities (SPEC §3.4 step 7).

@@ -19,12 +19,24 @@ struct Owned {
 
 impl Owned {
     fn problem(&self) -> LcpProblem<'_> {
-        LcpProblem { n: self.n, a: &self.a, b: &self.b, lo: &self.lo, hi: &self.hi, friction_index: None }
+        LcpProblem {
+            n: self.n,
+            a: &self.a,
+            b: &self.b,
+            lo: &self.lo,
+            hi: &self.hi,
+            friction_index: None,
+        }
     }
 
     fn w(&self, x: &[f64]) -> Vec<f64> {
         (0..self.n)
-            .map(|i| (0..self.n).map(|j| self.a[i * self.n + j] * x[j]).sum::<f64>() + self.b[i])
+            .map(|i| {
+                (0..self.n)
+                    .map(|j| self.a[i * self.n + j] * x[j])
+                    .sum::<f64>()
+                    + self.b[i]
+            })
             .collect()
     }
 
@@ -46,8 +58,16 @@ impl Owned {
             let (lo, hi) = (self.lo[i], self.hi[i]);
             worst = worst.max((lo - x[i]).max(x[i] - hi).max(0.0) / scale.max(1.0));
             // Distance to each branch of complementarity; the best branch must hold.
-            let at_lo = if lo.is_finite() { (x[i] - lo).abs() / scale.max(1.0) + (-w[i]).max(0.0) / scale } else { f64::INFINITY };
-            let at_hi = if hi.is_finite() { (hi - x[i]).abs() / scale.max(1.0) + w[i].max(0.0) / scale } else { f64::INFINITY };
+            let at_lo = if lo.is_finite() {
+                (x[i] - lo).abs() / scale.max(1.0) + (-w[i]).max(0.0) / scale
+            } else {
+                f64::INFINITY
+            };
+            let at_hi = if hi.is_finite() {
+                (hi - x[i]).abs() / scale.max(1.0) + w[i].max(0.0) / scale
+            } else {
+                f64::INFINITY
+            };
             let inside = w[i].abs() / scale;
             worst = worst.max(at_lo.min(at_hi).min(inside));
         }
@@ -80,26 +100,41 @@ fn problem(max_n: usize) -> impl Strategy<Value = Owned> {
             )
         })
         .prop_map(|(n, rank, entries, log_d, b, kinds, widths, duplicate)| {
-            let mut bm = DMatrix::from_row_slice(n, n, &entries).rows(0, rank).into_owned();
+            let mut bm = DMatrix::from_row_slice(n, n, &entries)
+                .rows(0, rank)
+                .into_owned();
             if let Some((from, to)) = duplicate {
                 let column = bm.column(from).into_owned();
                 bm.set_column(to, &column); // two identical constraint rows
             }
-            let d = DMatrix::from_diagonal(&DVector::from_iterator(n, log_d.iter().map(|l| 10f64.powf(*l))));
+            let d = DMatrix::from_diagonal(&DVector::from_iterator(
+                n,
+                log_d.iter().map(|l| 10f64.powf(*l)),
+            ));
             let a = &d * bm.transpose() * &bm * &d;
             let a = (&a + a.transpose()) * 0.5;
             let mut lo = vec![0.0; n];
             let mut hi = vec![0.0; n];
             for i in 0..n {
                 (lo[i], hi[i]) = match kinds[i] {
-                    0 => (0.0, f64::INFINITY),                   // a normal impulse
-                    1 => (-widths[2 * i], widths[2 * i + 1]),    // friction within a box
-                    2 => (f64::NEG_INFINITY, f64::INFINITY),     // a joint (equality) row
-                    _ => (-widths[2 * i], 0.0),                  // a one-sided box
+                    0 => (0.0, f64::INFINITY),                // a normal impulse
+                    1 => (-widths[2 * i], widths[2 * i + 1]), // friction within a box
+                    2 => (f64::NEG_INFINITY, f64::INFINITY),  // a joint (equality) row
+                    _ => (-widths[2 * i], 0.0),               // a one-sided box
                 };
             }
-            let b = b.iter().zip(log_d.iter()).map(|(v, l)| v * 10f64.powf(*l)).collect();
-            Owned { n, a: a.transpose().as_slice().to_vec(), b, lo, hi }
+            let b = b
+                .iter()
+                .zip(log_d.iter())
+                .map(|(v, l)| v * 10f64.powf(*l))
+                .collect();
+            Owned {
+                n,
+                a: a.transpose().as_slice().to_vec(),
+                b,
+                lo,
+                hi,
+            }
         })
 }
 
@@ -139,7 +174,11 @@ fn brute_force(original: &Owned) -> Option<f64> {
             if !free.is_empty() {
                 let aff = DMatrix::from_fn(free.len(), free.len(), |r, c| a[(free[r], free[c])]);
                 let rhs = DVector::from_fn(free.len(), |r, _| {
-                    -p.b[free[r]] - (0..n).filter(|j| assignment[*j] != 2).map(|j| a[(free[r], j)] * x[j]).sum::<f64>()
+                    -p.b[free[r]]
+                        - (0..n)
+                            .filter(|j| assignment[*j] != 2)
+                            .map(|j| a[(free[r], j)] * x[j])
+                            .sum::<f64>()
                 });
                 if let Ok(sol) = aff.svd(true, true).solve(&rhs, 1e-12) {
                     for (k, &i) in free.iter().enumerate() {
@@ -168,7 +207,10 @@ fn brute_force(original: &Owned) -> Option<f64> {
 #[test]
 fn a_thousand_random_boxed_lcps_satisfy_bounds_and_complementarity() {
     // A fixed seed: the same thousand problems every run.
-    let mut runner = TestRunner::new_with_rng(Config::default(), TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let mut runner = TestRunner::new_with_rng(
+        Config::default(),
+        TestRng::deterministic_rng(RngAlgorithm::ChaCha),
+    );
     let strategy = problem(60);
     let mut solver = LcpSolver::default();
     let mut x = Vec::new();
@@ -178,8 +220,17 @@ fn a_thousand_random_boxed_lcps_satisfy_bounds_and_complementarity() {
         let stats = solver.solve(&p.problem(), &mut x);
         assert!(x.iter().all(|v| v.is_finite()), "case {case}");
         let violation = p.violation(&x);
-        assert!(violation <= 1e-9, "case {case}: violation {violation:e} by {:?} on n = {}", stats.method, p.n);
-        assert!(stats.residual <= 1e-9, "case {case}: the solver's own residual agrees: {:e}", stats.residual);
+        assert!(
+            violation <= 1e-9,
+            "case {case}: violation {violation:e} by {:?} on n = {}",
+            stats.method,
+            p.n
+        );
+        assert!(
+            stats.residual <= 1e-9,
+            "case {case}: the solver's own residual agrees: {:e}",
+            stats.residual
+        );
         if stats.method == LcpMethod::Pivoting {
             pivoted += 1;
         }
@@ -188,8 +239,12 @@ fn a_thousand_random_boxed_lcps_satisfy_bounds_and_complementarity() {
             let best = brute_force(&p).expect("a PSD box LCP with a feasible point has a solution");
             let ours = p.objective(&x);
             // The objective's terms are of size scale·|x|; ε-regularisation moves it by ~1e-10 of that.
-            let tolerance = 1e-8 * (1.0 + p.scale(&x) * x.iter().map(|v| v.abs()).fold(0.0, f64::max));
-            assert!((ours - best).abs() <= tolerance, "case {case}: objective {ours} vs enumeration {best}");
+            let tolerance =
+                1e-8 * (1.0 + p.scale(&x) * x.iter().map(|v| v.abs()).fold(0.0, f64::max));
+            assert!(
+                (ours - best).abs() <= tolerance,
+                "case {case}: objective {ours} vs enumeration {best}"
+            );
         }
     }
     eprintln!("{pivoted} of 1000 by pivoting, {brute_forced} checked by enumeration");
@@ -226,12 +281,21 @@ fn a_box_across_two_boxes_has_four_redundant_contacts() {
         assert!(x[i] >= 0.0);
     }
     let total: f64 = x.iter().sum();
-    assert!((total - 2.0).abs() < 1e-12, "the total impulse stops unit mass at 2/s: {total}");
+    assert!(
+        (total - 2.0).abs() < 1e-12,
+        "the total impulse stops unit mass at 2/s: {total}"
+    );
 }
 
 #[test]
 fn non_finite_input_is_rejected_not_propagated() {
-    let p = Owned { n: 2, a: vec![1.0, 0.0, 0.0, f64::NAN], b: vec![-1.0, -1.0], lo: vec![0.0; 2], hi: vec![f64::INFINITY; 2] };
+    let p = Owned {
+        n: 2,
+        a: vec![1.0, 0.0, 0.0, f64::NAN],
+        b: vec![-1.0, -1.0],
+        lo: vec![0.0; 2],
+        hi: vec![f64::INFINITY; 2],
+    };
     let mut x = Vec::new();
     let stats = LcpSolver::default().solve(&p.problem(), &mut x);
     assert_eq!(stats.method, LcpMethod::Rejected);
@@ -241,8 +305,8 @@ fn non_finite_input_is_rejected_not_propagated() {
 #[test]
 fn mass_ratio_of_a_million_is_solved_exactly() {
     // A light and a heavy contact coupled: the diagonals differ by 1e6.
-    let (light, heavy) = (1e3, 1e-3);
-    let coupling = 0.5 * (light * heavy as f64).sqrt();
+    let (light, heavy): (f64, f64) = (1e3, 1e-3);
+    let coupling = 0.5 * (light * heavy).sqrt();
     let p = Owned {
         n: 2,
         a: vec![light, coupling, coupling, heavy],
@@ -253,7 +317,10 @@ fn mass_ratio_of_a_million_is_solved_exactly() {
     let mut x = Vec::new();
     LcpSolver::default().solve(&p.problem(), &mut x);
     let det = light * heavy - coupling * coupling;
-    let exact = [(heavy * 1.0 - coupling * 1e-6) / det, (light * 1e-6 - coupling * 1.0) / det];
+    let exact = [
+        (heavy * 1.0 - coupling * 1e-6) / det,
+        (light * 1e-6 - coupling * 1.0) / det,
+    ];
     // The second impulse wants to be negative: it is clamped at 0 and the first is b/A₁₁.
     assert!(exact[1] < 0.0);
     assert!((x[0] - 1.0 / light).abs() < 1e-15 && x[1] == 0.0, "{x:?}");

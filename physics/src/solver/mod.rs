@@ -1,7 +1,13 @@
 //! Constraint solvers: contacts, the boxed LCP, joints and motors.
 
 pub mod contact;
+pub mod island;
+pub mod joint;
 pub mod lcp;
+pub mod motor;
+pub mod simultaneous;
+pub mod soft;
+pub mod system;
 
 use crate::body::Body;
 use crate::math::{Vec2, cross, cross_scalar};
@@ -14,6 +20,7 @@ pub struct SolverBody {
     pub inv_mass: f64,
     pub inv_inertia: f64,
     pub position: Vec2,
+    pub angle: f64,
 }
 
 impl SolverBody {
@@ -24,6 +31,7 @@ impl SolverBody {
             inv_mass: body.inv_mass,
             inv_inertia: body.inv_inertia,
             position: body.position,
+            angle: body.angle,
         }
     }
 
@@ -42,18 +50,32 @@ impl SolverBody {
 pub enum ContactSolver {
     /// One contact at a time, once (SPEC §2.4.5): the naive baseline.
     Sequential,
-    /// The thesis: normal LCP, then a boxed friction LCP bounded by those normals (§3.2.4).
-    #[default]
+    /// The thesis: push-apart, a normal LCP, then a boxed friction LCP bounded by those
+    /// normals (§3.2.4); joints in their own passes.
     Thesis,
+    /// Box2D-v3-style soft step: substeps, soft contacts, relax, warm starting. For big
+    /// piles, where a dense solve costs too much.
+    Soft,
+    /// One boxed LCP per island with normals, friction bounded by the normal it solves
+    /// for, pins and joint motors; penetration removed by a split-impulse position pass.
+    #[default]
+    Exact,
 }
 
 impl ContactSolver {
-    pub const ALL: [ContactSolver; 2] = [ContactSolver::Sequential, ContactSolver::Thesis];
+    pub const ALL: [ContactSolver; 4] = [
+        ContactSolver::Sequential,
+        ContactSolver::Thesis,
+        ContactSolver::Soft,
+        ContactSolver::Exact,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             ContactSolver::Sequential => "sequential",
             ContactSolver::Thesis => "thesis",
+            ContactSolver::Soft => "soft",
+            ContactSolver::Exact => "exact",
         }
     }
 

@@ -1,0 +1,706 @@
+//! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
+
+use super::SolverBody;
+use super::island::{UnionFind, group_by_island};
+use crate::body::BodyHandle;
+use crate::math::{Rot, Vec2};
+use nalgebra::{DMatrix, DVector};
+
+/// Islands with at most this many joints are solved by one direct (Cholesky) solve per
+/// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (SPEC §3.3).
+pub const DIRECT_JOINT_LIMIT: usize = 256;
+
+/// A joint's handle in its world. Handles are never reused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct JointHandle(pub u32);
+
+impl JointHandle {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A pin joint between two bodies, or a body and the static world (`body_b: None`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Joint {
+    pub body_a: BodyHandle,
+    pub body_b: Option<BodyHandle>,
+    /// The anchor in each body's space (relative to its centroid, unrotated); for the world,
+    /// a world point.
+    pub local_anchor_a: Vec2,
+    pub local_anchor_b: Vec2,
+    /// Whether the two bodies still collide with each other (off by default: jointed robot
+    /// parts overlap around their pins, SPEC §3.1).
+    pub collide_connected: bool,
+    pub motor: Option<JointMotor>,
+}
+
+/// A joint as the solver sees it: body slots in the step's solver array (the static world
+/// is the slot past the last body) and the anchors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointConstraint {
+    pub joint: u32,
+    pub body_a: u32,
+    pub body_b: u32,
+    pub local_anchor_a: Vec2,
+    pub local_anchor_b: Vec2,
+    pub motor: Option<JointMotor>,
+    /// The predicted gap this step's position pass aims for: zero, unless the joint is
+    /// broken wider than one step may close (see [`JointIterations::max_closing`]).
+    pub gap_target: Vec2,
+}
+
+/// Drives the relative angular velocity ω_A − ω_B to `target_speed` with a torque of at
+/// most `max_torque`, reacting on both bodies (issue 4b).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointMotor {
+    pub target_speed: f64,
+    pub max_torque: f64,
+    pub enabled: bool,
+    /// Angular impulse the motor applied in the last step (torque = impulse / h).
+    pub last_impulse: f64,
+}
+
+/// How hard the joint passes iterate (SPEC §3.3 Rec: Gauss–Seidel with a tolerance and a cap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointIterations {
+    /// Stop once every predicted gap is below this (length units).
+    pub position_tolerance: f64,
+    /// Stop once every relative anchor speed is below this (length units per second).
+    pub velocity_tolerance: f64,
+    pub max_sweeps: usize,
+    /// The most a broken joint's gap may close in one step (so that repair is visible
+    /// rather than a teleport).
+    pub max_closing: f64,
+    /// A joint wider than this is broken: it is repaired by moving the bodies (see
+    /// [`JointBlockSolver::repair_positions`]), not by the velocity passes, which would
+    /// turn the whole gap into speed (gap/h) and, along a chain, add it up.
+    pub broken_gap: f64,
+}
+
+/// The 2×2 matrix K of SPEC eq. 39: the anchors' relative velocity change per unit impulse.
+fn effective_mass_matrix(a: &SolverBody, r_a: Vec2, b: &SolverBody, r_b: Vec2) -> [[f64; 2]; 2] {
+    let m = a.inv_mass + b.inv_mass;
+    let (ia, ib) = (a.inv_inertia, b.inv_inertia);
+    [
+        [
+            m + ia * r_a.y * r_a.y + ib * r_b.y * r_b.y,
+            -ia * r_a.x * r_a.y - ib * r_b.x * r_b.y,
+        ],
+        [
+            -ia * r_a.x * r_a.y - ib * r_b.x * r_b.y,
+            m + ia * r_a.x * r_a.x + ib * r_b.x * r_b.x,
+        ],
+    ]
+}
+
+/// Solves `K ψ = rhs` in closed form; `None` if K is singular (both bodies static).
+fn solve_2x2(k: [[f64; 2]; 2], rhs: Vec2) -> Option<Vec2> {
+    let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
+    if det.abs() <= f64::EPSILON * (k[0][0] * k[1][1]).abs() || det == 0.0 {
+        return None;
+    }
+    Some(Vec2::new(
+        (k[1][1] * rhs.x - k[0][1] * rhs.y) / det,
+        (k[0][0] * rhs.y - k[1][0] * rhs.x) / det,
+    ))
+}
+
+impl JointConstraint {
+    /// World anchor offsets from each centroid, `r_A` and `r_B`.
+    pub fn arms(&self, angles: (f64, f64)) -> (Vec2, Vec2) {
+        (
+            Rot::new(angles.0).apply(self.local_anchor_a),
+            Rot::new(angles.1).apply(self.local_anchor_b),
+        )
+    }
+
+    /// Removes the anchors' relative velocity (SPEC eq. 40). Returns |d_v| before.
+    fn correct_velocity(&self, bodies: &mut [SolverBody]) -> f64 {
+        let (ia, ib) = (self.body_a as usize, self.body_b as usize);
+        let (r_a, r_b) = self.arms((bodies[ia].angle, bodies[ib].angle));
+        let (a, b) = (&bodies[ia], &bodies[ib]);
+        let d_v = a.velocity_at(a.position + r_a) - b.velocity_at(b.position + r_b);
+        let k = effective_mass_matrix(a, r_a, b, r_b);
+        if let Some(psi) = solve_2x2(k, -d_v) {
+            let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
+            bodies[ia].apply_impulse(psi, pa);
+            bodies[ib].apply_impulse(-psi, pb);
+        }
+        d_v.norm()
+    }
+
+    /// Where the anchors would be after integrating the current velocities for `dt`.
+    pub fn predicted_gap(&self, bodies: &[SolverBody], dt: f64) -> Vec2 {
+        let end = |i: usize, local: Vec2| {
+            let b = &bodies[i];
+            b.position + b.velocity * dt + Rot::new(b.angle + b.angular_velocity * dt).apply(local)
+        };
+        end(self.body_a as usize, self.local_anchor_a)
+            - end(self.body_b as usize, self.local_anchor_b)
+    }
+
+    /// One Newton step on the predicted gap (SPEC eq. 34–39). Returns |d| before.
+    fn correct_position(&self, bodies: &mut [SolverBody], dt: f64) -> f64 {
+        let (ia, ib) = (self.body_a as usize, self.body_b as usize);
+        let d = self.predicted_gap(bodies, dt) - self.gap_target;
+        // The impulse acts at the anchors now, where the pin force really acts (at the
+        // predicted arms it would do work and drain energy); the gap is observed at the
+        // predicted pose, so K is the exact derivative and Newton converges.
+        let k = coupling_block(self, self, bodies, dt);
+        let (r_a, r_b) = self.arms((bodies[ia].angle, bodies[ib].angle));
+        if let Some(psi) = solve_2x2(k, -d / dt) {
+            let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
+            bodies[ia].apply_impulse(psi, pa);
+            bodies[ib].apply_impulse(-psi, pb);
+        }
+        d.norm()
+    }
+}
+
+/// Start of step: every joint's anchors stop drifting apart (SPEC §3.3 eq. 40), iterated.
+pub fn correct_velocities(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    it: &JointIterations,
+) -> usize {
+    for sweep in 0..it.max_sweeps {
+        let mut worst: f64 = 0.0;
+        for j in joints {
+            worst = worst.max(j.correct_velocity(bodies));
+        }
+        if worst < it.velocity_tolerance {
+            return sweep;
+        }
+    }
+    it.max_sweeps
+}
+
+/// After contacts: impulses that make every joint's anchors meet at the end of the step
+/// (SPEC §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
+pub fn correct_positions(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    dt: f64,
+    it: &JointIterations,
+) -> usize {
+    for sweep in 0..it.max_sweeps {
+        let mut worst: f64 = 0.0;
+        for j in joints.iter() {
+            worst = worst.max(j.correct_position(bodies, dt));
+        }
+        if worst < it.position_tolerance {
+            return sweep;
+        }
+    }
+    it.max_sweeps
+}
+
+/// What a joint's gap should be at the end of this step: closed, or `max_closing` narrower
+/// if it is wider than that now.
+pub fn gap_target(gap_now: Vec2, max_closing: f64) -> Vec2 {
+    let len = gap_now.norm();
+    if len > max_closing {
+        gap_now * (1.0 - max_closing / len)
+    } else {
+        Vec2::zeros()
+    }
+}
+
+/// What the velocity passes aim a joint's predicted gap at: closed for a healthy joint
+/// (the thesis method, SPEC §3.3), held where it is for a broken one, which only the
+/// position repair closes.
+pub fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
+    if gap_now.norm() > broken_gap {
+        gap_now
+    } else {
+        Vec2::zeros()
+    }
+}
+
+/// Joint motors as bounded velocity constraints, solved by projected Gauss–Seidel on the
+/// accumulated impulse so the bound ±max_torque·h holds over the whole step.
+pub fn drive_motors(
+    joints: &mut [JointConstraint],
+    bodies: &mut [SolverBody],
+    dt: f64,
+    sweeps: usize,
+) {
+    drive_motors_continue(joints, bodies, dt, sweeps, true);
+}
+
+/// Like [`drive_motors`], optionally keeping the impulses already applied this step so the
+/// bound holds over several rounds.
+fn drive_motors_continue(
+    joints: &mut [JointConstraint],
+    bodies: &mut [SolverBody],
+    dt: f64,
+    sweeps: usize,
+    fresh: bool,
+) {
+    if fresh {
+        for j in joints.iter_mut() {
+            if let Some(m) = j.motor.as_mut() {
+                m.last_impulse = 0.0;
+            }
+        }
+    }
+    for _ in 0..sweeps {
+        for j in joints.iter_mut() {
+            let Some(motor) = j.motor.as_mut().filter(|m| m.enabled) else {
+                continue;
+            };
+            let (ia, ib) = (j.body_a as usize, j.body_b as usize);
+            let k = bodies[ia].inv_inertia + bodies[ib].inv_inertia;
+            if k == 0.0 {
+                continue;
+            }
+            let relative = bodies[ia].angular_velocity - bodies[ib].angular_velocity;
+            let limit = motor.max_torque * dt;
+            let total =
+                (motor.last_impulse - (relative - motor.target_speed) / k).clamp(-limit, limit);
+            let delta = total - motor.last_impulse;
+            motor.last_impulse = total;
+            bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;
+            bodies[ib].angular_velocity -= delta * bodies[ib].inv_inertia;
+        }
+    }
+}
+
+/// Distance between a joint's two anchors now.
+pub fn gap(joint: &JointConstraint, bodies: &[SolverBody]) -> f64 {
+    joint.predicted_gap(bodies, 0.0).norm()
+}
+
+/// How the joint passes solve the coupled joints of an island.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum JointSolver {
+    /// Each joint alone in turn, repeated (SPEC §3.3 Rec): slow to converge on long chains.
+    GaussSeidel,
+    /// All joints of an island at once: K (2m×2m) factored by Cholesky, per Newton step.
+    #[default]
+    Direct,
+}
+
+/// Buffers for solving joints island by island, reused across steps.
+#[derive(Debug, Clone, Default)]
+pub struct JointBlockSolver {
+    uf: UnionFind,
+    grouped: Vec<(u32, u32)>,
+    island: Vec<JointConstraint>,
+}
+
+/// The velocity change at joint `p`'s anchors per unit impulse at joint `q`: one 2×2 block
+/// of K = J M⁻¹ Jᵀ, summed over the bodies the two joints share (signs: + on A, − on B).
+/// The impulse acts at `q`'s anchors now; `p`'s are observed `ahead` seconds on, turned by
+/// ω·ahead: for the position pass that is the exact derivative of the predicted gap, so the
+/// Newton steps converge quadratically even for fast-spinning links.
+fn coupling_block(
+    p: &JointConstraint,
+    q: &JointConstraint,
+    bodies: &[SolverBody],
+    ahead: f64,
+) -> [[f64; 2]; 2] {
+    let mut k = [[0.0; 2]; 2];
+    let angle_ahead =
+        |i: u32| bodies[i as usize].angle + ahead * bodies[i as usize].angular_velocity;
+    let (pa, pb) = p.arms((angle_ahead(p.body_a), angle_ahead(p.body_b)));
+    let (qa, qb) = q.arms((
+        bodies[q.body_a as usize].angle,
+        bodies[q.body_b as usize].angle,
+    ));
+    for (bp, sp, rp) in [(p.body_a, 1.0, pa), (p.body_b, -1.0, pb)] {
+        for (bq, sq, rq) in [(q.body_a, 1.0, qa), (q.body_b, -1.0, qb)] {
+            if bp != bq {
+                continue;
+            }
+            let t = &bodies[bp as usize];
+            let s = sp * sq;
+            k[0][0] += s * (t.inv_mass + t.inv_inertia * rp.y * rq.y);
+            k[0][1] += s * (-t.inv_inertia * rp.y * rq.x);
+            k[1][0] += s * (-t.inv_inertia * rp.x * rq.y);
+            k[1][1] += s * (t.inv_mass + t.inv_inertia * rp.x * rq.x);
+        }
+    }
+    k
+}
+
+/// The impulses that make `residual` zero for all joints of an island at once, to first
+/// order: K ψ = −residual. `None` if K is singular beyond repair.
+fn island_impulses(
+    joints: &[JointConstraint],
+    bodies: &[SolverBody],
+    ahead: f64,
+    residual: impl Fn(&JointConstraint, &[SolverBody]) -> Vec2,
+) -> Option<DVector<f64>> {
+    let m = joints.len();
+    let mut k = DMatrix::<f64>::zeros(2 * m, 2 * m);
+    let mut rhs = DVector::<f64>::zeros(2 * m);
+    for (p, jp) in joints.iter().enumerate() {
+        for (q, jq) in joints.iter().enumerate() {
+            let block = coupling_block(jp, jq, bodies, ahead);
+            for (r, row) in block.iter().enumerate() {
+                for (c, value) in row.iter().enumerate() {
+                    k[(2 * p + r, 2 * q + c)] = *value;
+                }
+            }
+        }
+        let d = residual(jp, bodies);
+        rhs[2 * p] = -d.x;
+        rhs[2 * p + 1] = -d.y;
+    }
+    // Redundant joints (closed loops at special poses) make K singular: a regularisation
+    // far below the entries' rounding keeps the solve going without changing answers.
+    let scale = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
+    for i in 0..2 * m {
+        k[(i, i)] += 1e-12 * scale;
+    }
+    let psi = k.lu().solve(&rhs)?;
+    psi.iter().all(|v| v.is_finite()).then_some(psi)
+}
+
+/// Applies `fraction` of the island impulses `psi` at the joints' current anchors.
+fn apply_island_impulses(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    psi: &DVector<f64>,
+    fraction: f64,
+) {
+    for (p, j) in joints.iter().enumerate() {
+        let impulse = Vec2::new(psi[2 * p], psi[2 * p + 1]) * fraction;
+        let (ia, ib) = (j.body_a as usize, j.body_b as usize);
+        let (r_a, r_b) = j.arms((bodies[ia].angle, bodies[ib].angle));
+        let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
+        bodies[ia].apply_impulse(impulse, pa);
+        bodies[ib].apply_impulse(-impulse, pb);
+    }
+}
+
+/// Largest remaining predicted gap of the island (relative to each joint's target).
+fn worst_predicted_gap(joints: &[JointConstraint], bodies: &[SolverBody], dt: f64) -> f64 {
+    joints
+        .iter()
+        .map(|j| (j.predicted_gap(bodies, dt) - j.gap_target).norm())
+        .fold(0.0, f64::max)
+}
+
+/// Newton steps on the island's predicted gaps. Each step must shrink the worst gap; if a
+/// full step does not (far from the solution the rotation makes the gap very nonlinear,
+/// and a full step can leap to a wildly spinning solution), half steps are tried, and the
+/// pass stops if none helps. False if the direct solve is impossible.
+fn close_island_gaps(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    dt: f64,
+    it: &JointIterations,
+) -> bool {
+    let mut worst = worst_predicted_gap(joints, bodies, dt);
+    for _ in 0..it.max_sweeps.min(10) {
+        if worst < it.position_tolerance {
+            break;
+        }
+        let residual =
+            |j: &JointConstraint, b: &[SolverBody]| (j.predicted_gap(b, dt) - j.gap_target) / dt;
+        let Some(psi) = island_impulses(joints, bodies, dt, residual) else {
+            return false;
+        };
+        let saved: Vec<(usize, SolverBody)> =
+            island_bodies(joints).map(|i| (i, bodies[i])).collect();
+        let mut fraction = 1.0;
+        let mut improved = false;
+        for _ in 0..5 {
+            apply_island_impulses(joints, bodies, &psi, fraction);
+            let now = worst_predicted_gap(joints, bodies, dt);
+            if now < worst {
+                worst = now;
+                improved = true;
+                break;
+            }
+            for &(i, b) in &saved {
+                bodies[i] = b;
+            }
+            fraction *= 0.5;
+        }
+        if !improved {
+            break; // the rest waits for the next step (see the note on heavy chains)
+        }
+    }
+    true
+}
+
+/// Moves `fraction` of the displacement that the island impulses `psi` would cause in one
+/// second: Δx = M⁻¹ψ, Δθ = I⁻¹ r×ψ. Positions change, velocities do not.
+fn displace_island(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    psi: &DVector<f64>,
+    fraction: f64,
+) {
+    for (p, j) in joints.iter().enumerate() {
+        let push = Vec2::new(psi[2 * p], psi[2 * p + 1]) * fraction;
+        let (ia, ib) = (j.body_a as usize, j.body_b as usize);
+        let (r_a, r_b) = j.arms((bodies[ia].angle, bodies[ib].angle));
+        for (i, r, sign) in [(ia, r_a, 1.0), (ib, r_b, -1.0)] {
+            let b = &mut bodies[i];
+            b.position += push * (sign * b.inv_mass);
+            b.angle += sign * b.inv_inertia * crate::math::cross(r, push);
+        }
+    }
+}
+
+/// The repair moves bodies by the smallest mass-weighted displacement, with rotations
+/// made this much costlier than physics would weigh them. A thin link's small inertia
+/// would otherwise let the first-order solve turn links by radians to save a little
+/// translation (measured: a 40-link chain stretched straight turns links 900 rad and the
+/// Newton steps stall); translations enter the gaps linearly, so a chain or tree closes
+/// in one step, and rotation is still used where a closed loop needs it.
+const REPAIR_ROTATION_WEIGHT: f64 = 1e-4;
+
+/// Each joint with its repair target: broken joints `max_closing` narrower (or closed),
+/// the others held as they are.
+fn with_repair_targets(
+    joints: &[JointConstraint],
+    bodies: &[SolverBody],
+    it: &JointIterations,
+) -> Vec<JointConstraint> {
+    joints
+        .iter()
+        .map(|j| {
+            let now = j.predicted_gap(bodies, 0.0);
+            let target = if now.norm() > it.broken_gap {
+                gap_target(now, it.max_closing)
+            } else {
+                now
+            };
+            JointConstraint {
+                gap_target: target,
+                ..*j
+            }
+        })
+        .collect()
+}
+
+fn repair_residual(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
+    j.predicted_gap(bodies, 0.0) - j.gap_target
+}
+
+/// Newton steps on the island's current gaps, moving bodies (not their velocities) until
+/// each joint is at its repair target. Backtracks like [`close_island_gaps`]. False if the
+/// direct solve is impossible.
+fn repair_island_positions(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    it: &JointIterations,
+) -> bool {
+    let joints = with_repair_targets(joints, bodies, it);
+    let worst_of = |bodies: &[SolverBody]| {
+        joints
+            .iter()
+            .map(|j| repair_residual(j, bodies).norm_squared())
+            .sum::<f64>()
+            .sqrt()
+    };
+    let mut worst = worst_of(bodies);
+    for _ in 0..20 {
+        if worst < it.position_tolerance {
+            break;
+        }
+        let Some(psi) = island_impulses(&joints, bodies, 0.0, repair_residual) else {
+            return false;
+        };
+        let saved: Vec<(usize, SolverBody)> =
+            island_bodies(&joints).map(|i| (i, bodies[i])).collect();
+        let mut fraction = 1.0;
+        let mut improved = false;
+        for _ in 0..12 {
+            displace_island(&joints, bodies, &psi, fraction);
+            let now = worst_of(bodies);
+            if now < worst {
+                worst = now;
+                improved = true;
+                break;
+            }
+            for &(i, b) in &saved {
+                bodies[i] = b;
+            }
+            fraction *= 0.5;
+        }
+        if !improved {
+            break;
+        }
+    }
+    true
+}
+
+/// The same repair one joint at a time, by Gauss–Seidel sweeps (large islands).
+fn repair_positions_sequential(
+    joints: &[JointConstraint],
+    bodies: &mut [SolverBody],
+    it: &JointIterations,
+) {
+    let joints = with_repair_targets(joints, bodies, it);
+    for _ in 0..it.max_sweeps {
+        let mut worst: f64 = 0.0;
+        for j in &joints {
+            let d = repair_residual(j, bodies);
+            worst = worst.max(d.norm());
+            let Some(push) = solve_2x2(coupling_block(j, j, bodies, 0.0), -d) else {
+                continue;
+            };
+            displace_island(
+                std::slice::from_ref(j),
+                bodies,
+                &DVector::from_column_slice(&[push.x, push.y]),
+                1.0,
+            );
+        }
+        if worst < it.position_tolerance {
+            break;
+        }
+    }
+}
+
+/// Body slots an island's joints touch (with repeats).
+fn island_bodies(joints: &[JointConstraint]) -> impl Iterator<Item = usize> + '_ {
+    joints
+        .iter()
+        .flat_map(|j| [j.body_a as usize, j.body_b as usize])
+}
+
+fn anchor_velocity_gap(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
+    let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
+    let (r_a, r_b) = j.arms((a.angle, b.angle));
+    a.velocity_at(a.position + r_a) - b.velocity_at(b.position + r_b)
+}
+
+impl JointBlockSolver {
+    /// Calls `solve` once per island with that island's joints, copied contiguously.
+    fn for_each_island(
+        &mut self,
+        joints: &mut [JointConstraint],
+        bodies: &mut [SolverBody],
+        mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
+    ) {
+        let dynamic = |slot: u32| {
+            bodies[slot as usize].inv_mass > 0.0 || bodies[slot as usize].inv_inertia > 0.0
+        };
+        group_by_island(
+            joints.len(),
+            bodies.len(),
+            |i| (joints[i].body_a, joints[i].body_b),
+            dynamic,
+            &mut self.uf,
+            &mut self.grouped,
+        );
+        let mut start = 0;
+        while start < self.grouped.len() {
+            let root = self.grouped[start].0;
+            let end = start
+                + self.grouped[start..]
+                    .iter()
+                    .take_while(|(r, _)| *r == root)
+                    .count();
+            self.island.clear();
+            self.island.extend(
+                self.grouped[start..end]
+                    .iter()
+                    .map(|&(_, i)| joints[i as usize]),
+            );
+            solve(&mut self.island, bodies);
+            for (k, &(_, i)) in self.grouped[start..end].iter().enumerate() {
+                joints[i as usize] = self.island[k];
+            }
+            start = end;
+        }
+    }
+
+    /// Before a step: every broken joint (wider than [`JointIterations::broken_gap`]) is
+    /// pulled up to `max_closing` closer by moving the bodies of its island, which adds no
+    /// kinetic energy — a stretched chain snaps together instead of whipping. Does
+    /// nothing (and costs one pass over the joints) when no joint is broken.
+    pub fn repair_positions(
+        &mut self,
+        solver: JointSolver,
+        joints: &mut [JointConstraint],
+        bodies: &mut [SolverBody],
+        it: &JointIterations,
+    ) {
+        if joints
+            .iter()
+            .all(|j| j.predicted_gap(bodies, 0.0).norm() <= it.broken_gap)
+        {
+            return;
+        }
+        self.for_each_island(joints, bodies, |island, bodies| {
+            let mut slots: Vec<usize> = island_bodies(island).collect();
+            slots.sort_unstable();
+            slots.dedup();
+            for &i in &slots {
+                bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
+            }
+            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            if !(direct && repair_island_positions(island, bodies, it)) {
+                repair_positions_sequential(island, bodies, it);
+            }
+            for &i in &slots {
+                bodies[i].inv_inertia /= REPAIR_ROTATION_WEIGHT;
+            }
+        });
+    }
+
+    /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
+    pub fn correct_velocities(
+        &mut self,
+        solver: JointSolver,
+        joints: &mut [JointConstraint],
+        bodies: &mut [SolverBody],
+        it: &JointIterations,
+    ) {
+        self.for_each_island(joints, bodies, |island, bodies| {
+            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            let solved = direct
+                && island_impulses(island, bodies, 0.0, anchor_velocity_gap)
+                    .map(|psi| apply_island_impulses(island, bodies, &psi, 1.0))
+                    .is_some();
+            if !solved {
+                correct_velocities(island, bodies, it);
+            }
+        });
+    }
+
+    /// Stage 6 (SPEC §3.3): motors, then Newton steps on the predicted gaps until every
+    /// joint closes. Motors and joints alternate so that both hold at the end;
+    /// `motors_started` says the motors' impulses of this step so far are in place.
+    pub fn correct_positions(
+        &mut self,
+        solver: JointSolver,
+        joints: &mut [JointConstraint],
+        bodies: &mut [SolverBody],
+        dt: f64,
+        it: &JointIterations,
+        motors_started: bool,
+    ) {
+        self.for_each_island(joints, bodies, |island, bodies| {
+            let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
+            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            if !direct {
+                if has_motor {
+                    drive_motors_continue(island, bodies, dt, 10, !motors_started);
+                }
+                correct_positions(island, bodies, dt, it);
+                return;
+            }
+            let outer = if has_motor { 8 } else { 1 };
+            for round in 0..outer {
+                if has_motor {
+                    // Keep what the contact solve already pushed so the bound holds overall.
+                    drive_motors_continue(island, bodies, dt, 4, round == 0 && !motors_started);
+                }
+                if !close_island_gaps(island, bodies, dt, it) {
+                    correct_positions(island, bodies, dt, it);
+                    break;
+                }
+            }
+        });
+    }
+}

@@ -1,0 +1,315 @@
+//! Simultaneous impulses (SPEC §2.4.6, §3.2), island by island: the thesis's two-stage
+//! friction, and the coupled model that solves normals, friction, pins and joint motors in
+//! one boxed LCP whose friction bounds follow the normal impulses.
+
+use super::SolverBody;
+use super::contact::Contact;
+use super::island::{UnionFind, group_by_island};
+use super::joint::JointConstraint;
+use super::lcp::{LcpProblem, LcpSolver};
+use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+
+/// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
+/// dense pivoting method, whose cost grows as n³.
+pub const DENSE_ROW_LIMIT: usize = 96;
+
+/// What happened in one island during the last step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IslandReport {
+    pub contacts: usize,
+    pub joints: usize,
+    pub rows: usize,
+    /// Whether the dense pivoting solve was used (else Gauss–Seidel).
+    pub pivoting: bool,
+    pub pivots: usize,
+    pub residual: f64,
+}
+
+/// The two-stage thesis pipeline or the coupled one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrictionModel {
+    /// SPEC §3.2.4 steps 1–6: normals without friction, then friction bounded by them.
+    TwoStage,
+    /// Normals, friction (bounds ±μ·normal, updated with it), pins and motors together.
+    Coupled,
+}
+
+/// Buffers reused across steps.
+#[derive(Debug, Clone, Default)]
+pub struct SimultaneousSolver {
+    uf: UnionFind,
+    grouped: Vec<(u32, u32)>,
+    /// Each island's span of `grouped`.
+    ranges: Vec<(usize, usize)>,
+    contact_count: usize,
+    scratch_contacts: Vec<Contact>,
+    scratch_joints: Vec<JointConstraint>,
+    pseudo: Vec<SolverBody>,
+    stage_one: Vec<f64>,
+    island_contacts: Vec<(u32, Contact)>,
+    island_joints: Vec<JointConstraint>,
+    joint_slots: Vec<u32>,
+    rows: Vec<Row>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    friction_index: Vec<Option<(usize, f64)>>,
+    x: Vec<f64>,
+    lcp: LcpSolver,
+    pub reports: Vec<IslandReport>,
+}
+
+impl SimultaneousSolver {
+    /// Solves every island and applies the impulses to `bodies`; contacts get their normal
+    /// and tangent impulses, joints with motors their motor impulse. With `TwoStage`,
+    /// joints are left to the joint passes, as in the thesis.
+    pub fn solve(
+        &mut self,
+        model: FrictionModel,
+        contacts: &mut [Contact],
+        joints: &mut [JointConstraint],
+        bodies: &mut [SolverBody],
+        targets: &VelocityTargets,
+    ) {
+        self.reports.clear();
+        self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
+        for island in 0..self.ranges.len() {
+            self.load_island(island, contacts, joints);
+            match model {
+                FrictionModel::TwoStage => self.solve_two_stage(bodies, targets),
+                FrictionModel::Coupled => self.solve_coupled(bodies, targets),
+            }
+            self.write_back(contacts, joints);
+        }
+    }
+
+    /// Removes penetration deeper than `slop` without adding energy (split impulse): the
+    /// normal rows, with the pins as equality rows so the push cannot open them, are solved
+    /// for pseudo-velocities that move `bodies`' positions and angles only. Each step
+    /// removes the fraction `rate` of the excess depth.
+    pub fn separate(
+        &mut self,
+        contacts: &[Contact],
+        joints: &[JointConstraint],
+        bodies: &mut [SolverBody],
+        dt: f64,
+        slop: f64,
+        rate: f64,
+    ) {
+        let mut contacts_copy = std::mem::take(&mut self.scratch_contacts);
+        contacts_copy.clear();
+        contacts_copy.extend_from_slice(contacts);
+        let mut joints_copy = std::mem::take(&mut self.scratch_joints);
+        joints_copy.clear();
+        joints_copy.extend_from_slice(joints);
+        self.group(&contacts_copy, &joints_copy, true, bodies);
+        let mut pseudo = std::mem::take(&mut self.pseudo);
+        pseudo.clear();
+        pseudo.extend(bodies.iter().map(|b| SolverBody {
+            velocity: crate::math::Vec2::zeros(),
+            angular_velocity: 0.0,
+            ..*b
+        }));
+        let targets = VelocityTargets {
+            dt,
+            bounce_below: f64::INFINITY,
+            friction: false,
+            close_joint_gaps: false,
+        };
+        for island in 0..self.ranges.len() {
+            self.load_island(island, &contacts_copy, &joints_copy);
+            if self.island_contacts.iter().all(|(_, c)| c.depth <= slop) {
+                continue;
+            }
+            self.island_joints.iter_mut().for_each(|j| j.motor = None);
+            velocity_rows(
+                &self.island_contacts,
+                &self.island_joints,
+                &pseudo,
+                &targets,
+                &mut self.rows,
+            );
+            let mut contact = self.island_contacts.iter();
+            for row in self.rows.iter_mut() {
+                if let RowKind::ContactNormal(_) = row.kind {
+                    let depth = contact.next().map_or(0.0, |(_, c)| c.depth);
+                    row.b = -rate * (depth - slop).max(0.0) / dt;
+                }
+            }
+            self.solve_rows(&mut pseudo, true);
+        }
+        for (body, p) in bodies.iter_mut().zip(&pseudo) {
+            body.position += p.velocity * dt;
+            body.angle += p.angular_velocity * dt;
+        }
+        self.pseudo = pseudo;
+        self.scratch_contacts = contacts_copy;
+        self.scratch_joints = joints_copy;
+    }
+
+    /// Groups contacts (and, if `with_joints`, joints) into islands: `ranges` of `grouped`.
+    fn group(
+        &mut self,
+        contacts: &[Contact],
+        joints: &[JointConstraint],
+        with_joints: bool,
+        bodies: &[SolverBody],
+    ) {
+        let nc = contacts.len();
+        let joint_count = if with_joints { joints.len() } else { 0 };
+        let dynamic = |slot: u32| {
+            bodies[slot as usize].inv_mass > 0.0 || bodies[slot as usize].inv_inertia > 0.0
+        };
+        let ends = |i: usize| {
+            if i < nc {
+                (contacts[i].body_a, contacts[i].body_b)
+            } else {
+                (joints[i - nc].body_a, joints[i - nc].body_b)
+            }
+        };
+        group_by_island(
+            nc + joint_count,
+            bodies.len(),
+            ends,
+            dynamic,
+            &mut self.uf,
+            &mut self.grouped,
+        );
+        self.contact_count = nc;
+        self.ranges.clear();
+        let mut start = 0;
+        while start < self.grouped.len() {
+            let root = self.grouped[start].0;
+            let end = start
+                + self.grouped[start..]
+                    .iter()
+                    .take_while(|(r, _)| *r == root)
+                    .count();
+            self.ranges.push((start, end));
+            start = end;
+        }
+    }
+
+    /// Copies island `island`'s contacts and joints into the island buffers.
+    fn load_island(&mut self, island: usize, contacts: &[Contact], joints: &[JointConstraint]) {
+        let (start, end) = self.ranges[island];
+        let nc = self.contact_count;
+        self.island_contacts.clear();
+        self.island_joints.clear();
+        self.joint_slots.clear();
+        for &(_, item) in &self.grouped[start..end] {
+            let item = item as usize;
+            if item < nc {
+                self.island_contacts.push((item as u32, contacts[item]));
+            } else {
+                self.island_joints.push(joints[item - nc]);
+                self.joint_slots.push((item - nc) as u32);
+            }
+        }
+    }
+
+    /// SPEC §3.2.4: stage one finds frictionless normals, stage two solves normals and
+    /// friction with friction bounded by ±μ·(stage-one normal).
+    fn solve_two_stage(&mut self, bodies: &mut [SolverBody], targets: &VelocityTargets) {
+        let frictionless = VelocityTargets {
+            friction: false,
+            ..*targets
+        };
+        velocity_rows(
+            &self.island_contacts,
+            &[],
+            bodies,
+            &frictionless,
+            &mut self.rows,
+        );
+        self.solve_rows(bodies, false);
+        std::mem::swap(&mut self.stage_one, &mut self.x);
+        velocity_rows(&self.island_contacts, &[], bodies, targets, &mut self.rows);
+        let mut normal = 0;
+        for row in self.rows.iter_mut() {
+            match row.kind {
+                RowKind::ContactNormal(_) => normal += 1,
+                RowKind::ContactTangent(_) => {
+                    let mu = row.friction_of.map_or(0.0, |(_, mu)| mu);
+                    let bound = mu * self.stage_one[normal - 1];
+                    (row.lo, row.hi) = (-bound, bound);
+                    row.friction_of = None;
+                }
+                _ => {}
+            }
+        }
+        self.solve_rows(bodies, true);
+    }
+
+    fn solve_coupled(&mut self, bodies: &mut [SolverBody], targets: &VelocityTargets) {
+        velocity_rows(
+            &self.island_contacts,
+            &self.island_joints,
+            bodies,
+            targets,
+            &mut self.rows,
+        );
+        self.solve_rows(bodies, true);
+    }
+
+    /// Solves the current rows and, if `apply`, applies their impulses.
+    fn solve_rows(&mut self, bodies: &mut [SolverBody], apply: bool) {
+        let n = self.rows.len();
+        assemble(&self.rows, bodies, &mut self.a);
+        self.b.clear();
+        self.lo.clear();
+        self.hi.clear();
+        self.friction_index.clear();
+        for r in &self.rows {
+            self.b.push(r.b);
+            self.lo.push(r.lo);
+            self.hi.push(r.hi);
+            self.friction_index.push(r.friction_of);
+        }
+        let problem = LcpProblem {
+            n,
+            a: &self.a,
+            b: &self.b,
+            lo: &self.lo,
+            hi: &self.hi,
+            friction_index: Some(&self.friction_index),
+        };
+        let pivoting = n <= DENSE_ROW_LIMIT;
+        let stats = if pivoting {
+            self.lcp.solve(&problem, &mut self.x)
+        } else {
+            self.lcp.solve_iterative(&problem, &mut self.x)
+        };
+        if apply {
+            for (row, &x) in self.rows.iter().zip(&self.x) {
+                row.apply(bodies, x);
+            }
+            self.reports.push(IslandReport {
+                contacts: self.island_contacts.len(),
+                joints: self.island_joints.len(),
+                rows: n,
+                pivoting,
+                pivots: stats.pivots,
+                residual: stats.residual,
+            });
+        }
+    }
+
+    /// Records the impulses in the contacts and joints they belong to.
+    fn write_back(&mut self, contacts: &mut [Contact], joints: &mut [JointConstraint]) {
+        for (row, &x) in self.rows.iter().zip(&self.x) {
+            match row.kind {
+                RowKind::ContactNormal(i) => contacts[i as usize].normal_impulse = x,
+                RowKind::ContactTangent(i) => contacts[i as usize].tangent_impulse = x,
+                RowKind::JointMotor(k) => {
+                    let slot = self.joint_slots[k as usize] as usize;
+                    if let Some(m) = joints[slot].motor.as_mut() {
+                        m.last_impulse = x;
+                    }
+                }
+                RowKind::JointX(_) | RowKind::JointY(_) => {}
+            }
+        }
+    }
+}

@@ -1,0 +1,278 @@
+//! Simultaneous contacts: restitution, friction, stacking, momentum (issue 3).
+//! Metre-sized bodies, g = 10 m/s², h = 1/60 s unless a test says otherwise.
+
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Vec2, World};
+
+const G: f64 = 10.0;
+const H: f64 = 1.0 / 60.0;
+const SIMULTANEOUS: [ContactSolver; 2] = [ContactSolver::Thesis, ContactSolver::Exact];
+
+fn world(solver: ContactSolver, friction: f64) -> World {
+    let mut w = World::new(Vec2::new(0.0, G));
+    w.settings.contact_solver = solver;
+    w.friction = friction;
+    w
+}
+
+/// A static floor whose top surface is the line y = 0. Its restitution is 1 so that the
+/// pair's (the minimum, SPEC §6.4) is the other body's.
+fn floor(w: &mut World, width: f64) -> BodyHandle {
+    let shape = ConvexPolygon::rectangle(width, 1.0).unwrap();
+    w.add_body(
+        BodyDef::new(shape, 0.0)
+            .restitution(1.0)
+            .at(Vec2::new(0.0, 0.5), 0.0),
+    )
+    .unwrap()
+}
+
+fn square(w: &mut World, size: f64, centre: Vec2, e: f64) -> BodyHandle {
+    let shape = ConvexPolygon::rectangle(size, size).unwrap();
+    w.add_body(BodyDef::new(shape, 1.0).restitution(e).at(centre, 0.0))
+        .unwrap()
+}
+
+/// Steps until the body has bounced and risen to its peak; returns the peak height of its
+/// bottom above the floor and the largest |ω| seen.
+fn rebound_peak(w: &mut World, body: BodyHandle, half: f64) -> (f64, f64) {
+    let mut max_omega: f64 = 0.0;
+    let mut bounced = false;
+    for _ in 0..2000 {
+        w.step(H);
+        let b = w.body(body).unwrap();
+        max_omega = max_omega.max(b.angular_velocity.abs());
+        if b.velocity.y < 0.0 {
+            bounced = true;
+        } else if bounced {
+            return (-(b.position.y + half), max_omega);
+        }
+    }
+    panic!("no rebound");
+}
+
+#[test]
+fn square_landing_flat_bounces_straight_up() {
+    // SPEC §2.4.5: with e = 1 and two contacts, one-at-a-time impulses set the square
+    // spinning; simultaneous impulses keep it level and return it to its drop height.
+    let drop = 2.0;
+    for solver in SIMULTANEOUS {
+        let mut w = world(solver, 0.5);
+        floor(&mut w, 20.0);
+        let b = square(&mut w, 1.0, Vec2::new(0.0, -drop - 0.5), 1.0);
+        let (peak, omega) = rebound_peak(&mut w, b, 0.5);
+        assert!(omega < 1e-9, "{solver:?}: |ω| reached {omega}");
+        assert!(
+            (peak - drop).abs() < 0.01 * drop,
+            "{solver:?}: rebound {peak} of {drop}"
+        );
+    }
+    let mut w = world(ContactSolver::Sequential, 0.5);
+    floor(&mut w, 20.0);
+    let b = square(&mut w, 1.0, Vec2::new(0.0, -drop - 0.5), 1.0);
+    let (_, omega) = rebound_peak(&mut w, b, 0.5);
+    assert!(
+        omega > 0.1,
+        "the sequential baseline rocks, as the thesis says: {omega}"
+    );
+}
+
+#[test]
+fn bounce_reaches_e_squared_of_the_drop() {
+    let drop = 3.0;
+    for solver in SIMULTANEOUS {
+        let mut w = world(solver, 0.5);
+        floor(&mut w, 20.0);
+        let b = square(&mut w, 0.5, Vec2::new(0.0, -drop - 0.25), 0.5);
+        let (peak, _) = rebound_peak(&mut w, b, 0.25);
+        let expected = 0.25 * drop;
+        assert!(
+            (peak - expected).abs() < 0.02 * expected,
+            "{solver:?}: {peak} vs {expected}"
+        );
+    }
+}
+
+/// A box resting on a static slope of angle `theta` (the slope falls towards +x).
+fn incline(solver: ContactSolver, theta: f64, mu: f64) -> (World, BodyHandle) {
+    let mut w = world(solver, mu);
+    let slope = ConvexPolygon::rectangle(40.0, 1.0).unwrap();
+    // Turned by +θ (clockwise on a y-down screen) the top face descends towards +x.
+    let normal = Vec2::new(theta.sin(), -theta.cos()); // outward, pointing up the page
+    w.add_body(BodyDef::new(slope, 0.0).at(-normal * 0.5, theta))
+        .unwrap();
+    let b = ConvexPolygon::rectangle(1.0, 0.5).unwrap();
+    let body = w
+        .add_body(BodyDef::new(b, 1.0).at(normal * 0.25, theta))
+        .unwrap();
+    (w, body)
+}
+
+#[test]
+fn incline_sticks_above_tan_theta_and_slides_below() {
+    let theta = 20f64.to_radians();
+    for solver in SIMULTANEOUS {
+        let (mut w, b) = incline(solver, theta, theta.tan() + 0.1);
+        let start = w.body(b).unwrap().position;
+        for _ in 0..300 {
+            w.step(H);
+        }
+        let creep = (w.body(b).unwrap().position - start).norm();
+        assert!(creep < 0.005 * 1.0, "{solver:?}: crept {creep}");
+
+        let mu = 0.2;
+        let (mut w, b) = incline(solver, theta, mu);
+        for _ in 0..30 {
+            w.step(H); // settle into sliding
+        }
+        let v0 = w.body(b).unwrap().velocity.norm();
+        for _ in 0..120 {
+            w.step(H);
+        }
+        let accel = (w.body(b).unwrap().velocity.norm() - v0) / (120.0 * H);
+        let expected = G * (theta.sin() - mu * theta.cos());
+        assert!(
+            (accel - expected).abs() < 0.02 * expected,
+            "{solver:?}: a = {accel}, expected {expected}"
+        );
+    }
+}
+
+fn stack(
+    solver: ContactSolver,
+    n: usize,
+    mu: f64,
+    offsets: impl Fn(usize) -> f64,
+) -> (World, Vec<BodyHandle>) {
+    let mut w = world(solver, mu);
+    floor(&mut w, 20.0);
+    let boxes = (0..n)
+        .map(|i| square(&mut w, 1.0, Vec2::new(offsets(i), -0.5 - i as f64), 0.0))
+        .collect();
+    (w, boxes)
+}
+
+#[test]
+fn stack_of_ten_stands_still() {
+    for solver in [ContactSolver::Exact, ContactSolver::Thesis] {
+        let (mut w, boxes) = stack(solver, 10, 0.6, |_| 0.0);
+        let top = *boxes.last().unwrap();
+        let start = w.body(top).unwrap().position;
+        let mut late_speed: f64 = 0.0;
+        for step in 0..600 {
+            w.step(H);
+            if step >= 120 {
+                let fastest = w
+                    .bodies()
+                    .map(|(_, b)| b.velocity.norm())
+                    .fold(0.0, f64::max);
+                late_speed = late_speed.max(fastest);
+            }
+        }
+        let drift = (w.body(top).unwrap().position - start).x.abs();
+        assert!(drift < 0.01, "{solver:?}: top drifted {drift}");
+        // After settling nothing moves faster than gravity adds in one step (g·h ≈ 0.17).
+        assert!(
+            late_speed < 0.1 * G * H,
+            "{solver:?}: jitter speed {late_speed}"
+        );
+    }
+}
+
+#[test]
+fn momentum_is_conserved_in_a_free_collision() {
+    // A turned square hits another corner-first: one contact point, no gravity.
+    for (solver, e, mu) in [
+        (ContactSolver::Exact, 1.0, 0.0),
+        (ContactSolver::Thesis, 1.0, 0.0),
+        (ContactSolver::Exact, 0.3, 0.5),
+    ] {
+        let mut w = World::new(Vec2::zeros());
+        w.settings.contact_solver = solver;
+        w.friction = mu;
+        let a = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        w.add_body(
+            BodyDef::new(a.clone(), 1.0)
+                .restitution(e)
+                .at(Vec2::new(0.0, 0.0), 0.6)
+                .velocity(Vec2::new(3.0, 0.4), 0.5),
+        )
+        .unwrap();
+        w.add_body(
+            BodyDef::new(a, 2.0)
+                .restitution(e)
+                .at(Vec2::new(2.0, 0.3), 0.0)
+                .velocity(Vec2::new(-1.0, 0.0), -0.2),
+        )
+        .unwrap();
+        let (p0, l0, k0) = (
+            w.linear_momentum(),
+            w.angular_momentum(),
+            w.kinetic_energy(),
+        );
+        let mut touched = false;
+        for _ in 0..120 {
+            w.step(1.0 / 120.0);
+            touched |= w.contacts().iter().any(|c| c.normal_impulse > 0.0);
+        }
+        assert!(touched, "{solver:?}: the bodies must collide");
+        assert!(
+            (w.linear_momentum() - p0).norm() < 1e-9 * p0.norm(),
+            "{solver:?}: p"
+        );
+        assert!(
+            (w.angular_momentum() - l0).abs() < 1e-9 * l0.abs().max(1.0),
+            "{solver:?}: L"
+        );
+        if e == 1.0 {
+            assert!(
+                (w.kinetic_energy() - k0).abs() < 1e-9 * k0,
+                "{solver:?}: KE {k0} → {}",
+                w.kinetic_energy()
+            );
+        }
+    }
+}
+
+#[test]
+fn separate_islands_do_not_influence_each_other() {
+    let build = |stacks: &[f64]| {
+        let mut w = world(ContactSolver::Exact, 0.5);
+        floor(&mut w, 40.0);
+        for &x in stacks {
+            for i in 0..4 {
+                square(
+                    &mut w,
+                    1.0,
+                    Vec2::new(x + 0.1 * i as f64, -0.6 - 1.05 * i as f64),
+                    0.2,
+                );
+            }
+        }
+        w
+    };
+    let bits = |w: &World, skip: usize| -> Vec<u64> {
+        w.bodies()
+            .skip(skip)
+            .take(4)
+            .flat_map(|(_, b)| {
+                [
+                    b.position.x,
+                    b.position.y,
+                    b.angle,
+                    b.velocity.x,
+                    b.velocity.y,
+                    b.angular_velocity,
+                ]
+            })
+            .map(f64::to_bits)
+            .collect()
+    };
+    let (mut both, mut left, mut right) = (build(&[-5.0, 5.0]), build(&[-5.0]), build(&[5.0]));
+    for _ in 0..240 {
+        both.step(H);
+        left.step(H);
+        right.step(H);
+    }
+    assert_eq!(bits(&both, 1), bits(&left, 1));
+    assert_eq!(bits(&both, 5), bits(&right, 1));
+}
