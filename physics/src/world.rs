@@ -129,6 +129,10 @@ pub struct World {
     joints: Vec<Option<Joint>>,
     /// Body pairs `(i, j)`, `i < j`, that a joint keeps from colliding; sorted.
     non_colliding: Vec<(u32, u32)>,
+    /// Bodies with at least one joint, sorted.
+    jointed: Vec<u32>,
+    /// Pairs kept apart by [`World::ignore_collisions`], besides the jointed ones.
+    ignored_pairs: Vec<(u32, u32)>,
     body_motors: Vec<(BodyHandle, BodyMotor)>,
     manifolds: Vec<Manifold>,
     contacts: Vec<Contact>,
@@ -277,6 +281,15 @@ impl World {
     }
 
     fn rebuild_collision_filter(&mut self) {
+        self.jointed = self
+            .joints
+            .iter()
+            .flatten()
+            .flat_map(|j| [Some(j.body_a.0), j.body_b.map(|b| b.0)])
+            .flatten()
+            .collect();
+        self.jointed.sort_unstable();
+        self.jointed.dedup();
         self.non_colliding = self
             .joints
             .iter()
@@ -286,9 +299,19 @@ impl World {
                 let (a, b) = (j.body_a.0, j.body_b?.0);
                 Some((a.min(b), a.max(b)))
             })
+            .chain(self.ignored_pairs.iter().copied())
             .collect();
         self.non_colliding.sort_unstable();
         self.non_colliding.dedup();
+    }
+
+    /// Bodies `a` and `b` never collide with each other (e.g. a mechanism's parts that
+    /// would lie in different planes, like a linkage and its frame).
+    pub fn ignore_collisions(&mut self, a: BodyHandle, b: BodyHandle) {
+        if a != b {
+            self.ignored_pairs.push((a.0.min(b.0), a.0.max(b.0)));
+            self.rebuild_collision_filter();
+        }
     }
 
     pub fn step_count(&self) -> u64 {
@@ -433,6 +456,10 @@ impl World {
                 (true, false) => (c.body_b, c.normal),
                 _ => continue,
             };
+            // Moving one part of a jointed mechanism would open its joints.
+            if self.jointed.binary_search(&moving).is_ok() {
+                continue;
+            }
             if let Some(body) = self.bodies[moving as usize].as_mut() {
                 body.position += direction * gap;
             }
