@@ -6,3 +6,7 @@
 pub use pe;
 
 pub mod app;
+pub mod cli;
+pub mod db;
+pub mod model;
+pub mod sim;

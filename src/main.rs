@@ -1,11 +1,5 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    match robosim::app::run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("robosim: {e}");
-            ExitCode::from(2)
-        }
-    }
+    robosim::cli::main(std::env::args_os(), robosim::app::run)
 }

@@ -8,7 +8,8 @@ use egui::{Color32, Pos2, Sense, Shape, Stroke};
 use pe::{BodyDef, ConvexPolygon, Vec2, World};
 
 /// Runs the app in a native window until it is closed.
-pub fn run() -> eframe::Result {
+pub fn run(db: Option<std::path::PathBuf>) -> Result<(), String> {
+    let _ = db;
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("RoboSim")
@@ -20,6 +21,7 @@ pub fn run() -> eframe::Result {
         options,
         Box::new(|_cc| Ok(Box::new(RoboSimApp::default()))),
     )
+    .map_err(|e| e.to_string())
 }
 
 /// The app's state.

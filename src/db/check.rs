@@ -1,0 +1,301 @@
+//! Whether a model makes sense: ranges, shapes, unique names, references, connected
+//! robots (SPEC §4.1), anchors inside bodies. Every problem names file, line, element.
+
+use super::problem::Problem;
+use super::{FileKind, clip};
+use crate::model::{BodyDef, Model, Robot, Scene};
+use pe::{ContactSolver, ConvexPolygon, Vec2};
+use std::collections::BTreeMap;
+
+/// The step range a scene may ask for: beyond it the motor and contact models stop
+/// making sense (SPEC §6.1 recommends 0.01–0.1; we allow a decade either side).
+pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
+
+/// All problems of `model`, whose files are named by `file`.
+pub fn check(model: &Model, file: impl Fn(FileKind) -> String) -> Vec<Problem> {
+    let mut out = Vec::new();
+    let bodies_file = file(FileKind::Bodies);
+    let robots_file = file(FileKind::Robots);
+    let scenes_file = file(FileKind::Scenes);
+    duplicates(
+        model.bodies.iter().map(|b| (&b.name, b.location)),
+        &bodies_file,
+        "body",
+        &mut out,
+    );
+    for body in &model.bodies {
+        check_body(body, &bodies_file, &mut out);
+    }
+    duplicates(
+        model.robots.iter().map(|r| (&r.name, r.location)),
+        &robots_file,
+        "robot",
+        &mut out,
+    );
+    for robot in &model.robots {
+        check_robot(model, robot, &robots_file, &mut out);
+    }
+    duplicates(
+        model.scenes.iter().map(|s| (&s.name, s.location)),
+        &scenes_file,
+        "scene",
+        &mut out,
+    );
+    for scene in &model.scenes {
+        check_scene(model, scene, &scenes_file, &mut out);
+    }
+    out
+}
+
+fn duplicates<'a>(
+    names: impl Iterator<Item = (&'a String, crate::model::Location)>,
+    file: &str,
+    kind: &str,
+    out: &mut Vec<Problem>,
+) {
+    let mut first: BTreeMap<&str, usize> = BTreeMap::new();
+    for (name, location) in names {
+        let key = name.trim();
+        if key.is_empty() {
+            out.push(Problem::error(file, &format!("<{kind}>"), "the name is empty").at(location));
+        } else if let Some(line) = first.get(key) {
+            out.push(
+                Problem::error(
+                    file,
+                    &format!("<{kind}> \"{}\"", clip(key)),
+                    format!("the name is already used on line {line}"),
+                )
+                .at(location),
+            );
+        } else {
+            first.insert(key, location.line);
+        }
+    }
+}
+
+/// The body's polygon, or why it is not one.
+pub fn polygon(body: &BodyDef) -> Result<ConvexPolygon, pe::ShapeError> {
+    let points: Vec<Vec2> = body
+        .vertices
+        .iter()
+        .map(|v| Vec2::new(v[0], v[1]))
+        .collect();
+    ConvexPolygon::new(&points)
+}
+
+fn check_body(body: &BodyDef, file: &str, out: &mut Vec<Problem>) {
+    let what = format!("<body> \"{}\"", clip(&body.name));
+    let mut error =
+        |message: String| out.push(Problem::error(file, &what, message).at(body.location));
+    if body.density < 0.0 {
+        error(format!(
+            "density {} is negative (0 makes a static body)",
+            body.density
+        ));
+    }
+    if !(0.0..=1.0).contains(&body.cor) {
+        error(format!("cor {} is outside [0, 1]", body.cor));
+    }
+    if let Some(mu) = body.friction.filter(|mu| *mu < 0.0) {
+        error(format!("friction {mu} is negative"));
+    }
+    if let Err(e) = polygon(body) {
+        error(format!("the vertices are not a usable convex polygon: {e}"));
+    }
+}
+
+fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>) {
+    let name = clip(&robot.name);
+    let mut aliases: BTreeMap<&str, usize> = BTreeMap::new();
+    for (i, b) in robot.bodies.iter().enumerate() {
+        let p = &b.placement;
+        let what = format!("<body> \"{}\" in robot \"{name}\"", clip(&p.alias));
+        if aliases.insert(p.alias.trim(), i).is_some() {
+            out.push(
+                Problem::error(file, &what, "the alias is already used in this robot")
+                    .at(p.location),
+            );
+        }
+        if model.body(&p.source).is_none() {
+            out.push(
+                Problem::error(
+                    file,
+                    &what,
+                    format!("source \"{}\" is not a body in bodies.xml", clip(&p.source)),
+                )
+                .at(p.location),
+            );
+        }
+        for m in &b.motors {
+            let what = format!("<force> on {what}");
+            if m.time1 < m.time0 {
+                out.push(
+                    Problem::warning(file, &what, "time1 is before time0: the motor never runs")
+                        .at(m.location),
+                );
+            }
+            if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
+                out.push(
+                    Problem::error(file, &what, "startTorque, maxTorque and increase must be ≥ 0 (the sign of angular gives the direction)")
+                        .at(m.location),
+                );
+            }
+        }
+    }
+    // Connectivity by union-find over aliases (SPEC §4.1).
+    let mut parent: Vec<usize> = (0..robot.bodies.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for j in &robot.joints {
+        let what = format!(
+            "<joint> {}–{} in robot \"{name}\"",
+            clip(&j.body_a),
+            clip(&j.body_b)
+        );
+        let a = aliases.get(j.body_a.trim()).copied();
+        let b = aliases.get(j.body_b.trim()).copied();
+        for (end, alias, found) in [("bodyA", &j.body_a, a), ("bodyB", &j.body_b, b)] {
+            if found.is_none() {
+                out.push(
+                    Problem::error(
+                        file,
+                        &what,
+                        format!("{end} \"{}\" is not a body of this robot", clip(alias)),
+                    )
+                    .at(j.location),
+                );
+            }
+        }
+        if let Some(m) = &j.motor
+            && m.max_torque < 0.0
+        {
+            out.push(
+                Problem::error(file, &format!("<motor> of {what}"), "maxTorque must be ≥ 0")
+                    .at(m.location),
+            );
+        }
+        let (Some(a), Some(b)) = (a, b) else { continue };
+        if a == b {
+            out.push(
+                Problem::error(file, &what, "a joint needs two different bodies").at(j.location),
+            );
+            continue;
+        }
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        parent[ra] = rb;
+        // The pin should lie in both bodies (SPEC §4.3.2: the centre of their overlap).
+        let point = j.point(&robot.bodies[a].placement);
+        let inside = [a, b].iter().any(|&i| {
+            let p = &robot.bodies[i].placement;
+            model
+                .body(&p.source)
+                .and_then(|d| polygon(d).ok())
+                .is_some_and(|poly| {
+                    let (s, c) = p.orientation.sin_cos();
+                    let (dx, dy) = (point[0] - p.x, point[1] - p.y);
+                    poly.contains(Vec2::new(c * dx + s * dy, -s * dx + c * dy))
+                })
+        });
+        if !inside {
+            out.push(
+                Problem::warning(
+                    file,
+                    &what,
+                    format!(
+                        "the pin at ({}, {}) lies in neither body",
+                        point[0], point[1]
+                    ),
+                )
+                .at(j.location),
+            );
+        }
+    }
+    let roots: std::collections::BTreeSet<usize> = (0..robot.bodies.len())
+        .map(|i| root(&mut parent, i))
+        .collect();
+    if roots.len() > 1 {
+        let first = root(&mut parent, 0);
+        let loose: Vec<&str> = (0..robot.bodies.len())
+            .filter(|&i| root(&mut parent, i) != first)
+            .map(|i| robot.bodies[i].placement.alias.as_str())
+            .collect();
+        out.push(
+            Problem::error(
+                file,
+                &format!("<robot> \"{name}\""),
+                format!("not all bodies are connected through joints: {loose:?} are not joined to \"{}\"", robot.bodies[0].placement.alias),
+            )
+            .at(robot.location),
+        );
+    }
+}
+
+fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>) {
+    let what = format!("<scene> \"{}\"", clip(&scene.name));
+    let mut error =
+        |message: String| out.push(Problem::error(file, &what, message).at(scene.location));
+    if scene.friction < 0.0 {
+        error(format!("friction {} is negative", scene.friction));
+    }
+    if let Some(h) = scene.timestep
+        && !(TIMESTEP_RANGE.0..=TIMESTEP_RANGE.1).contains(&h)
+    {
+        error(format!(
+            "timestep {h} s is outside [{}, {}] s",
+            TIMESTEP_RANGE.0, TIMESTEP_RANGE.1
+        ));
+    }
+    if let Some(solver) = &scene.solver
+        && ContactSolver::from_name(solver.trim()).is_none()
+    {
+        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
+        error(format!(
+            "solver \"{}\" is not one of {names:?}",
+            clip(solver)
+        ));
+    }
+    for r in &scene.robots {
+        if model.robot(&r.source).is_none() {
+            out.push(
+                Problem::error(
+                    file,
+                    &format!("<robot> in scene \"{}\"", clip(&scene.name)),
+                    format!(
+                        "source \"{}\" is not a robot in robots.xml",
+                        clip(&r.source)
+                    ),
+                )
+                .at(r.location),
+            );
+        }
+    }
+    let mut aliases: BTreeMap<&str, ()> = BTreeMap::new();
+    for b in &scene.bodies {
+        let what = format!(
+            "<body> \"{}\" in scene \"{}\"",
+            clip(&b.alias),
+            clip(&scene.name)
+        );
+        if aliases.insert(b.alias.trim(), ()).is_some() {
+            out.push(
+                Problem::error(file, &what, "the alias is already used in this scene")
+                    .at(b.location),
+            );
+        }
+        if model.body(&b.source).is_none() {
+            out.push(
+                Problem::error(
+                    file,
+                    &what,
+                    format!("source \"{}\" is not a body in bodies.xml", clip(&b.source)),
+                )
+                .at(b.location),
+            );
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! One thing wrong with a database, said so that a user can find and fix it.
+
+use crate::model::Location;
+use std::fmt;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Severity {
+    /// Loads, but is probably not what the user meant.
+    Warning,
+    /// The record (or the file) cannot be used as it is.
+    Error,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Problem {
+    pub severity: Severity,
+    /// The file's path as the user gave it (e.g. `data/robots.xml`).
+    pub file: String,
+    pub location: Option<Location>,
+    /// The element and, where it has one, its name: `<joint> in robot "housenka"`.
+    pub element: String,
+    pub message: String,
+}
+
+impl Problem {
+    pub fn error(file: &str, element: &str, message: impl Into<String>) -> Self {
+        Self {
+            severity: Severity::Error,
+            file: file.to_string(),
+            location: None,
+            element: element.to_string(),
+            message: message.into(),
+        }
+    }
+
+    pub fn warning(file: &str, element: &str, message: impl Into<String>) -> Self {
+        Self {
+            severity: Severity::Warning,
+            ..Self::error(file, element, message)
+        }
+    }
+
+    pub fn at(mut self, location: Location) -> Self {
+        if location.line > 0 {
+            self.location = Some(location);
+        }
+        self
+    }
+
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(l) = self.location {
+            write!(f, ":{}:{}", l.line, l.column)?;
+        }
+        let severity = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        write!(f, ": {severity}: {}: {}", self.element, self.message)
+    }
+}

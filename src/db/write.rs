@@ -1,0 +1,185 @@
+//! Model records back to the three files' text, in the element and attribute names of
+//! SPEC §4.3; extensions only where a record uses them, unknown attributes kept.
+
+use crate::model::{BodyDef, ExtraAttributes, Robot, Scene};
+use quick_xml::escape::escape;
+use std::fmt::Write;
+
+/// The shortest text that reads back to the same f64: whole numbers without a point
+/// (`1000000`, as a person would type them), everything else as Rust's round-trip repr.
+pub fn number(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v}")
+    } else {
+        format!("{v:?}")
+    }
+}
+
+struct Tag {
+    text: String,
+}
+
+impl Tag {
+    fn open(indent: usize, name: &str) -> Self {
+        Self {
+            text: format!("{:indent$}<{name}", "", indent = indent),
+        }
+    }
+
+    fn text(mut self, key: &str, value: &str) -> Self {
+        let _ = write!(self.text, " {key}=\"{}\"", escape(value));
+        self
+    }
+
+    fn num(self, key: &str, value: f64) -> Self {
+        self.text(key, &number(value))
+    }
+
+    fn extra(mut self, extra: &ExtraAttributes) -> Self {
+        for (k, v) in extra {
+            self = self.text(k, v);
+        }
+        self
+    }
+
+    /// `<name …/>`
+    fn empty(self, out: &mut String) {
+        out.push_str(&self.text);
+        out.push_str("/>\n");
+    }
+
+    /// `<name …>`, children to follow.
+    fn start(self, out: &mut String) {
+        out.push_str(&self.text);
+        out.push_str(">\n");
+    }
+}
+
+const HEADER: &str = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+
+pub fn bodies(bodies: &[BodyDef]) -> String {
+    let mut out = format!("{HEADER}<bodies>\n");
+    for b in bodies {
+        let mut tag = Tag::open(2, "body")
+            .text("name", &b.name)
+            .num("density", b.density)
+            .num("cor", b.cor);
+        if let Some(mu) = b.friction {
+            tag = tag.num("friction", mu);
+        }
+        tag.extra(&b.extra).start(&mut out);
+        for v in &b.vertices {
+            Tag::open(4, "vertex")
+                .num("x", v[0])
+                .num("y", v[1])
+                .empty(&mut out);
+        }
+        out.push_str("  </body>\n");
+    }
+    out.push_str("</bodies>\n");
+    out
+}
+
+pub fn robots(robots: &[Robot]) -> String {
+    let mut out = format!("{HEADER}<robots>\n");
+    for r in robots {
+        Tag::open(2, "robot")
+            .text("name", &r.name)
+            .extra(&r.extra)
+            .start(&mut out);
+        for b in &r.bodies {
+            let p = &b.placement;
+            let tag = Tag::open(4, "body")
+                .text("alias", &p.alias)
+                .text("source", &p.source)
+                .num("x", p.x)
+                .num("y", p.y)
+                .num("orientation", p.orientation)
+                .extra(&p.extra);
+            if b.motors.is_empty() {
+                tag.empty(&mut out);
+                continue;
+            }
+            tag.start(&mut out);
+            for m in &b.motors {
+                Tag::open(6, "force")
+                    .num("time0", m.time0 as f64)
+                    .num("time1", m.time1 as f64)
+                    .num("angular", m.angular)
+                    .num("startTorque", m.start_torque)
+                    .num("maxTorque", m.max_torque)
+                    .num("increase", m.increase)
+                    .extra(&m.extra)
+                    .empty(&mut out);
+            }
+            out.push_str("    </body>\n");
+        }
+        for j in &r.joints {
+            let mut tag = Tag::open(4, "joint")
+                .text("bodyA", &j.body_a)
+                .text("bodyB", &j.body_b)
+                .num("anchorAx", j.anchor_ax)
+                .num("anchorAy", j.anchor_ay);
+            if j.collide {
+                tag = tag.text("collide", "true");
+            }
+            let tag = tag.extra(&j.extra);
+            match &j.motor {
+                None => tag.empty(&mut out),
+                Some(m) => {
+                    tag.start(&mut out);
+                    Tag::open(6, "motor")
+                        .num("time0", m.time0 as f64)
+                        .num("time1", m.time1 as f64)
+                        .num("angular", m.angular)
+                        .num("maxTorque", m.max_torque)
+                        .extra(&m.extra)
+                        .empty(&mut out);
+                    out.push_str("    </joint>\n");
+                }
+            }
+        }
+        out.push_str("  </robot>\n");
+    }
+    out.push_str("</robots>\n");
+    out
+}
+
+pub fn scenes(scenes: &[Scene]) -> String {
+    let mut out = format!("{HEADER}<scenes>\n");
+    for s in scenes {
+        let mut tag = Tag::open(2, "scene")
+            .text("name", &s.name)
+            .num("gravitation", s.gravitation)
+            .num("friction", s.friction);
+        if let Some(h) = s.timestep {
+            tag = tag.num("timestep", h);
+        }
+        if let Some(solver) = &s.solver {
+            tag = tag.text("solver", solver);
+        }
+        tag.extra(&s.extra).start(&mut out);
+        for r in &s.robots {
+            Tag::open(4, "robot")
+                .text("source", &r.source)
+                .num("x", r.x)
+                .num("y", r.y)
+                .num("orientation", r.orientation)
+                .extra(&r.extra)
+                .empty(&mut out);
+        }
+        for b in &s.bodies {
+            Tag::open(4, "body")
+                .text("alias", &b.alias)
+                .text("source", &b.source)
+                .num("x", b.x)
+                .num("y", b.y)
+                .num("orientation", b.orientation)
+                .extra(&b.extra)
+                .empty(&mut out);
+        }
+        out.push_str("  </scene>\n");
+    }
+    out.push_str("</scenes>\n");
+    out
+}

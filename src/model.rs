@@ -1,0 +1,184 @@
+//! What the database holds (SPEC §4.3): body definitions, robots made of placed bodies,
+//! joints and motors, and scenes of placed robots and bodies. Plain data: no physics, no
+//! files. Lengths are in the files' units (the thesis's pixels, y down), angles in radians.
+
+/// Where an item was read from (1-based line and column), for messages. Never part of an
+/// item's identity: two items equal in content are equal wherever they were read.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Location {
+    pub line: usize,
+    pub column: usize,
+}
+
+impl PartialEq for Location {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// Attributes this version does not know, kept so that saving never drops them.
+pub type ExtraAttributes = Vec<(String, String)>;
+
+/// A reusable shape: `<body name density cor>` with `<vertex x y>` children (bodies.xml).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BodyDef {
+    pub name: String,
+    /// Mass per unit area; 0 makes the body static (terrain, or a robot's fixed pivot).
+    pub density: f64,
+    /// Coefficient of restitution e in [0, 1]; a contact uses the smaller of its pair's.
+    pub cor: f64,
+    /// Optional override of the scene's friction μ (extension: attribute `friction`).
+    pub friction: Option<f64>,
+    /// Vertices relative to the body's origin, the point a placement puts at (x, y).
+    pub vertices: Vec<[f64; 2]>,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+/// The thesis's motor (`<force>` on a robot body, SPEC §4.4): a torque on that body alone.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BodyMotorDef {
+    /// Active for steps time0 ≤ t < time1.
+    pub time0: u64,
+    pub time1: u64,
+    /// Target angular speed in radians per step; its sign gives the direction.
+    pub angular: f64,
+    pub start_torque: f64,
+    pub max_torque: f64,
+    /// Fraction of startTorque added per step while below target.
+    pub increase: f64,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+/// A joint motor (extension: `<motor>` inside `<joint>`): drives ω_A − ω_B to `angular`
+/// (radians per step) with at most `maxTorque`, reacting on both bodies.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointMotorDef {
+    pub time0: u64,
+    pub time1: u64,
+    pub angular: f64,
+    pub max_torque: f64,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+/// A body placed in a robot's frame: `<body alias source x y orientation>`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Placement {
+    /// The instance's name within its robot or scene.
+    pub alias: String,
+    /// The body definition's name in bodies.xml (surrounding whitespace is tolerated).
+    pub source: String,
+    pub x: f64,
+    pub y: f64,
+    pub orientation: f64,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RobotBody {
+    pub placement: Placement,
+    pub motors: Vec<BodyMotorDef>,
+}
+
+/// `<joint bodyA bodyB anchorAx anchorAy>`: the pin is at bodyA's placement plus the
+/// anchor offset, in robot coordinates (SPEC §6.6).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct JointDef {
+    pub body_a: String,
+    pub body_b: String,
+    pub anchor_ax: f64,
+    pub anchor_ay: f64,
+    /// Extension (attribute `collide`): the two bodies also collide with each other.
+    pub collide: bool,
+    pub motor: Option<JointMotorDef>,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+impl JointDef {
+    /// The joint's point in robot coordinates, given bodyA's placement.
+    pub fn point(&self, body_a: &Placement) -> [f64; 2] {
+        [body_a.x + self.anchor_ax, body_a.y + self.anchor_ay]
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Robot {
+    pub name: String,
+    pub bodies: Vec<RobotBody>,
+    pub joints: Vec<JointDef>,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+impl Robot {
+    pub fn body(&self, alias: &str) -> Option<&RobotBody> {
+        self.bodies
+            .iter()
+            .find(|b| b.placement.alias == alias.trim())
+    }
+}
+
+/// A robot placed in a scene: `<robot source x y orientation>`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneRobot {
+    pub source: String,
+    pub x: f64,
+    pub y: f64,
+    pub orientation: f64,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Scene {
+    pub name: String,
+    /// Gravity along +y (down on screen), in length units per s².
+    pub gravitation: f64,
+    /// Coulomb μ for every contact (unless both bodies override it).
+    pub friction: f64,
+    /// Extension: the step h in seconds ([`DEFAULT_TIMESTEP`] when absent).
+    pub timestep: Option<f64>,
+    /// Extension: the contact solver's name (`thesis`, `exact`, `soft`, `sequential`).
+    pub solver: Option<String>,
+    pub robots: Vec<SceneRobot>,
+    pub bodies: Vec<Placement>,
+    pub extra: ExtraAttributes,
+    pub location: Location,
+}
+
+/// The step when a scene gives none (SPEC §6.1: the thesis's numbers behave at h ≪ 1).
+pub const DEFAULT_TIMESTEP: f64 = 0.05;
+
+impl Scene {
+    pub fn timestep(&self) -> f64 {
+        self.timestep.unwrap_or(DEFAULT_TIMESTEP)
+    }
+}
+
+/// The three collections of a database, in file order.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Model {
+    pub bodies: Vec<BodyDef>,
+    pub robots: Vec<Robot>,
+    pub scenes: Vec<Scene>,
+}
+
+impl Model {
+    /// Looks a body definition up by name; whitespace around `name` is ignored
+    /// (the thesis's own example says `source=" housenka"`).
+    pub fn body(&self, name: &str) -> Option<&BodyDef> {
+        self.bodies.iter().find(|b| b.name == name.trim())
+    }
+
+    pub fn robot(&self, name: &str) -> Option<&Robot> {
+        self.robots.iter().find(|r| r.name == name.trim())
+    }
+
+    pub fn scene(&self, name: &str) -> Option<&Scene> {
+        self.scenes.iter().find(|s| s.name == name.trim())
+    }
+}

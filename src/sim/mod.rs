@@ -1,0 +1,340 @@
+//! A scene from the database as a running `pe::World` (issue 6): placement composition,
+//! joints from anchors, both motor kinds, the step counter and per-step metrics.
+
+pub mod trace;
+
+use crate::db;
+use crate::model::{Model, Placement, Scene};
+use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
+
+/// Why a scene cannot be simulated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BuildError {
+    #[error("there is no scene \"{0}\" in the database")]
+    UnknownScene(String),
+    #[error("scene \"{scene}\": {problem}")]
+    Invalid { scene: String, problem: String },
+}
+
+/// One simulated body and how traces name it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimBody {
+    /// The alias of a scene body, `"{source}#{i}/{alias}"` for a body of the i-th robot.
+    pub id: String,
+    pub handle: BodyHandle,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimJoint {
+    /// `"{source}#{i}/{bodyA}-{bodyB}"`.
+    pub id: String,
+    pub handle: JointHandle,
+    /// The motor's window in steps and target in radians per step, if it has one.
+    pub motor_window: Option<(u64, u64, f64)>,
+}
+
+/// What one step looked like.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Metrics {
+    pub step: u64,
+    pub time: f64,
+    pub kinetic: f64,
+    pub potential: f64,
+    pub momentum: Vec2,
+    pub angular_momentum: f64,
+    pub max_joint_gap: f64,
+    pub contacts: usize,
+}
+
+/// A motor's applied torque in the last step, for plots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotorTorque {
+    pub id: String,
+    pub torque: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    pub world: World,
+    pub bodies: Vec<SimBody>,
+    pub joints: Vec<SimJoint>,
+    /// Which body each body motor drives, by index into `bodies`.
+    body_motor_owners: Vec<usize>,
+    pub dt: f64,
+    pub scene_name: String,
+    model: Model,
+    solver: ContactSolver,
+}
+
+/// A placement composed with a parent frame: world = origin + R(angle)·local; angles add.
+fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (Vec2, f64) {
+    let (s, c) = frame.2.sin_cos();
+    let (x, y) = (local.0, local.1);
+    (
+        Vec2::new(frame.0 + c * x - s * y, frame.1 + s * x + c * y),
+        frame.2 + local.2,
+    )
+}
+
+fn placement_frame(p: &Placement) -> (f64, f64, f64) {
+    (p.x, p.y, p.orientation)
+}
+
+impl Simulation {
+    /// Builds scene `name` of `model`. `dt` overrides the scene's step, `solver` its solver.
+    pub fn new(
+        model: &Model,
+        name: &str,
+        dt: Option<f64>,
+        solver: Option<ContactSolver>,
+    ) -> Result<Self, BuildError> {
+        let scene = model
+            .scene(name)
+            .ok_or_else(|| BuildError::UnknownScene(name.to_string()))?;
+        let invalid = |problem: String| BuildError::Invalid {
+            scene: scene.name.clone(),
+            problem,
+        };
+        let dt = dt.unwrap_or(scene.timestep());
+        if !(db::TIMESTEP_RANGE.0..=db::TIMESTEP_RANGE.1).contains(&dt) {
+            return Err(invalid(format!(
+                "the step {dt} s is outside [{}, {}] s",
+                db::TIMESTEP_RANGE.0,
+                db::TIMESTEP_RANGE.1
+            )));
+        }
+        let solver = match (solver, &scene.solver) {
+            (Some(s), _) => s,
+            (None, Some(name)) => ContactSolver::from_name(name.trim())
+                .ok_or_else(|| invalid(format!("unknown solver \"{name}\"")))?,
+            (None, None) => ContactSolver::default(),
+        };
+        let mut sim = Self {
+            world: World::new(Vec2::new(0.0, scene.gravitation)),
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            body_motor_owners: Vec::new(),
+            dt,
+            scene_name: scene.name.clone(),
+            model: model.clone(),
+            solver,
+        };
+        sim.populate(scene).map_err(invalid)?;
+        Ok(sim)
+    }
+
+    fn add_body(
+        &mut self,
+        id: String,
+        placement: &Placement,
+        at: (Vec2, f64),
+    ) -> Result<BodyHandle, String> {
+        let def = self
+            .model
+            .body(&placement.source)
+            .ok_or_else(|| format!("{id}: source \"{}\" is not a body", placement.source))?;
+        let polygon = db::polygon(def).map_err(|e| format!("{id}: body \"{}\": {e}", def.name))?;
+        let mut body = BodyDef::new(polygon, def.density)
+            .restitution(def.cor)
+            .at(at.0, at.1);
+        if let Some(mu) = def.friction {
+            body = body.friction(mu);
+        }
+        let handle = self
+            .world
+            .add_body(body)
+            .map_err(|e| format!("{id}: {e}"))?;
+        self.bodies.push(SimBody { id, handle });
+        Ok(handle)
+    }
+
+    fn populate(&mut self, scene: &Scene) -> Result<(), String> {
+        self.world.friction = scene.friction;
+        self.world.settings.contact_solver = self.solver;
+        let model = self.model.clone();
+        for (i, placed) in scene.robots.iter().enumerate() {
+            let robot = model.robot(&placed.source).ok_or_else(|| {
+                format!("robot #{i}: source \"{}\" is not a robot", placed.source)
+            })?;
+            let prefix = format!("{}#{i}", robot.name);
+            let frame = (placed.x, placed.y, placed.orientation);
+            let mut handles = Vec::new();
+            for b in &robot.bodies {
+                let p = &b.placement;
+                let id = format!("{prefix}/{}", p.alias);
+                let handle = self.add_body(id, p, compose(frame, placement_frame(p)))?;
+                for m in &b.motors {
+                    self.world.add_body_motor(
+                        handle,
+                        pe::BodyMotor::new(
+                            m.time0,
+                            m.time1,
+                            m.angular,
+                            m.start_torque,
+                            m.max_torque,
+                            m.increase,
+                        ),
+                    );
+                    self.body_motor_owners.push(self.bodies.len() - 1);
+                }
+                handles.push((p.alias.trim().to_string(), handle));
+            }
+            // A robot's static bodies are its mount (a pivot, a frame): in a real machine the
+            // moving parts pass in front of it, so it collides with the scene, not with them.
+            for (k, &(_, mount)) in handles.iter().enumerate() {
+                if self.world.body(mount).is_some_and(|b| b.is_static()) {
+                    for (m, &(_, other)) in handles.iter().enumerate() {
+                        if m != k {
+                            self.world.ignore_collisions(mount, other);
+                        }
+                    }
+                }
+            }
+            let find = |alias: &str| {
+                handles
+                    .iter()
+                    .find(|(a, _)| a == alias.trim())
+                    .map(|(_, h)| *h)
+            };
+            for j in &robot.joints {
+                let id = format!("{prefix}/{}-{}", j.body_a.trim(), j.body_b.trim());
+                let a = robot
+                    .body(&j.body_a)
+                    .ok_or_else(|| format!("{id}: no body \"{}\"", j.body_a))?;
+                let (ha, hb) = match (find(&j.body_a), find(&j.body_b)) {
+                    (Some(ha), Some(hb)) => (ha, hb),
+                    _ => return Err(format!("{id}: bodyA or bodyB is not a body of the robot")),
+                };
+                let point = j.point(&a.placement);
+                let (anchor, _) = compose(frame, (point[0], point[1], 0.0));
+                let mut def = JointDef::new(ha, Some(hb), anchor);
+                def.collide_connected = j.collide;
+                let mut motor_window = None;
+                if let Some(m) = &j.motor {
+                    def.motor = Some(JointMotor {
+                        target_speed: m.angular / self.dt,
+                        max_torque: m.max_torque,
+                        enabled: (m.time0..m.time1).contains(&0),
+                        last_impulse: 0.0,
+                    });
+                    motor_window = Some((m.time0, m.time1, m.angular));
+                }
+                let handle = self
+                    .world
+                    .add_joint(def)
+                    .map_err(|e| format!("{id}: {e}"))?;
+                self.joints.push(SimJoint {
+                    id,
+                    handle,
+                    motor_window,
+                });
+            }
+        }
+        for p in &scene.bodies {
+            self.add_body(p.alias.clone(), p, (Vec2::new(p.x, p.y), p.orientation))?;
+        }
+        self.world.settings.length_scale = length_scale(&self.world);
+        Ok(())
+    }
+
+    /// Back to the scene's first state.
+    pub fn reset(&mut self) {
+        let (model, name, dt, solver) = (
+            self.model.clone(),
+            self.scene_name.clone(),
+            self.dt,
+            self.solver,
+        );
+        *self = Self::new(&model, &name, Some(dt), Some(solver))
+            .expect("a scene that built once builds again");
+    }
+
+    pub fn step_count(&self) -> u64 {
+        self.world.step_count()
+    }
+
+    pub fn time(&self) -> f64 {
+        self.step_count() as f64 * self.dt
+    }
+
+    /// One step of `dt`; joint motors switch on and off by their windows.
+    pub fn step(&mut self) {
+        let step = self.world.step_count();
+        for j in &self.joints {
+            if let Some((t0, t1, _)) = j.motor_window
+                && let Some(joint) = self.world.joint_mut(j.handle)
+                && let Some(m) = joint.motor.as_mut()
+            {
+                m.enabled = (t0..t1).contains(&step);
+                if !m.enabled {
+                    m.last_impulse = 0.0;
+                }
+            }
+        }
+        self.world.step(self.dt);
+    }
+
+    pub fn metrics(&self) -> Metrics {
+        Metrics {
+            step: self.step_count(),
+            time: self.time(),
+            kinetic: self.world.kinetic_energy(),
+            potential: self.world.potential_energy(),
+            momentum: self.world.linear_momentum(),
+            angular_momentum: self.world.angular_momentum(),
+            max_joint_gap: self.world.max_joint_gap(),
+            contacts: self.world.contacts().len(),
+        }
+    }
+
+    /// Every motor's torque in the last step: body motors by their ramp, joint motors by
+    /// their impulse over the step.
+    pub fn motor_torques(&self) -> Vec<MotorTorque> {
+        let mut out: Vec<MotorTorque> = self
+            .world
+            .body_motors()
+            .iter()
+            .zip(&self.body_motor_owners)
+            .map(|((_, m), &owner)| MotorTorque {
+                id: self.bodies[owner].id.clone(),
+                torque: m.current * if m.angular < 0.0 { -1.0 } else { 1.0 },
+            })
+            .collect();
+        for j in &self.joints {
+            if let Some(m) = self.world.joint(j.handle).and_then(|j| j.motor) {
+                out.push(MotorTorque {
+                    id: j.id.clone(),
+                    torque: m.last_impulse / self.dt,
+                });
+            }
+        }
+        out
+    }
+
+    /// Whether any body's state is not finite (the guard against a blow-up).
+    pub fn has_non_finite_state(&self) -> bool {
+        self.world.bodies().any(|(_, b)| {
+            !(b.position.x.is_finite()
+                && b.position.y.is_finite()
+                && b.angle.is_finite()
+                && b.velocity.x.is_finite()
+                && b.velocity.y.is_finite()
+                && b.angular_velocity.is_finite())
+        })
+    }
+}
+
+/// The world's length scale for tolerances: the median size (bounding radius) of the
+/// dynamic bodies — scenes are in pixels, tens of units per body, not metres.
+fn length_scale(world: &World) -> f64 {
+    let mut sizes: Vec<f64> = world
+        .bodies()
+        .filter(|(_, b)| !b.is_static())
+        .map(|(_, b)| b.bounding_radius())
+        .collect();
+    if sizes.is_empty() {
+        return 1.0;
+    }
+    sizes.sort_by(f64::total_cmp);
+    sizes[sizes.len() / 2]
+}

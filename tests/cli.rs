@@ -1,0 +1,215 @@
+//! The `robosim` binary (issue 6): `run` and `check` as a user's script would call them.
+
+use assert_cmd::Command;
+
+fn robosim() -> Command {
+    Command::cargo_bin("robosim").unwrap()
+}
+
+fn run(args: &[&str]) -> std::process::Output {
+    robosim()
+        .args(["run", "--db", "data"])
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn run_writes_parseable_json_lines_at_0_every_k_and_the_last_step() {
+    let out = run(&["--scene", "stack of boxes", "--steps", "10", "--every", "4"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let records: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let steps: Vec<u64> = records
+        .iter()
+        .map(|r| r["step"].as_u64().unwrap())
+        .collect();
+    assert_eq!(steps, [0, 4, 8, 10]);
+    let r = &records[1];
+    assert!((r["time"].as_f64().unwrap() - 4.0 / 60.0).abs() < 1e-15);
+    let body = &r["bodies"][1];
+    assert_eq!(body["id"], "box 1");
+    for key in ["x", "y", "angle", "vx", "vy", "omega"] {
+        assert!(body[key].is_f64(), "{key}");
+    }
+    assert!(r["energy"]["kinetic"].is_f64() && r["energy"]["potential"].is_f64());
+    assert!(r["joints"].as_array().unwrap().is_empty());
+}
+
+#[test]
+fn the_same_run_twice_is_byte_identical() {
+    let args = [
+        "--scene",
+        "car on terrain",
+        "--steps",
+        "300",
+        "--every",
+        "7",
+    ];
+    let (a, b) = (run(&args), run(&args));
+    assert!(a.status.success());
+    assert!(!a.stdout.is_empty());
+    assert_eq!(a.stdout, b.stdout);
+}
+
+#[test]
+fn csv_has_a_header_and_one_row_per_record() {
+    let out = run(&[
+        "--scene",
+        "double pendulum",
+        "--steps",
+        "5",
+        "--format",
+        "csv",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    assert_eq!(
+        header.iter().take(4).collect::<Vec<_>>(),
+        ["step", "time", "kinetic", "potential"]
+    );
+    assert!(header.iter().any(|h| h == "double pendulum#0/upper.omega"));
+    assert!(
+        header
+            .iter()
+            .any(|h| h == "double pendulum#0/upper-lower.gap")
+    );
+    let rows: Vec<_> = rows.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), 6);
+    assert!(rows.iter().all(|r| r.len() == header.len()));
+}
+
+#[test]
+fn out_writes_a_file_and_dt_and_solver_apply() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("trace.jsonl");
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "3",
+        "--dt",
+        "0.01",
+        "--solver",
+        "thesis",
+        "--out",
+    ])
+    .status;
+    assert!(!out.success(), "--out needs a value");
+    let status = robosim()
+        .args([
+            "run",
+            "--db",
+            "data",
+            "--scene",
+            "stack of boxes",
+            "--steps",
+            "3",
+            "--dt",
+            "0.01",
+        ])
+        .args(["--solver", "thesis", "--out", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(status.status.success() && status.stdout.is_empty());
+    let last: serde_json::Value = serde_json::from_str(
+        std::fs::read_to_string(&path)
+            .unwrap()
+            .lines()
+            .last()
+            .unwrap(),
+    )
+    .unwrap();
+    assert!((last["time"].as_f64().unwrap() - 0.03).abs() < 1e-15);
+}
+
+/// Every failure: exit code 2 and one line on stderr naming the problem.
+#[test]
+fn errors_are_one_line_and_exit_2() {
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["run", "--db", "data", "--scene", "no such scene"],
+            "no scene \"no such scene\"",
+        ),
+        (
+            &["run", "--db", "no/such/dir", "--scene", "x"],
+            "not a database folder",
+        ),
+        (
+            &[
+                "run", "--db", "data", "--scene", "walker", "--solver", "magic",
+            ],
+            "unknown solver",
+        ),
+        (
+            &["run", "--db", "data", "--scene", "walker", "--dt", "5"],
+            "outside",
+        ),
+        (
+            &["run", "--db", "data", "--scene", "walker", "--every", "0"],
+            "--every",
+        ),
+        (&["bogus"], "unrecognized subcommand"),
+    ];
+    for (args, says) in cases {
+        let out = robosim().args(args).output().unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"));
+    }
+}
+
+#[test]
+fn run_refuses_an_invalid_database() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("bodies.xml"),
+        "<bodies><body name=\"x\" density=\"oops\" cor=\"0\"/></bodies>",
+    )
+    .unwrap();
+    let out = robosim()
+        .args(["run", "--db", dir.path().to_str().unwrap(), "--scene", "s"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("bodies.xml:1:") && stderr.contains("density=\"oops\" is not a number"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn check_passes_the_default_database_and_fails_a_broken_one() {
+    let out = robosim().args(["check", "--db", "data"]).output().unwrap();
+    assert!(out.status.success());
+    assert!(
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .contains("0 errors, 0 warnings")
+    );
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        "tests/corpus/dangling_scenes.xml",
+        dir.path().join("scenes.xml"),
+    )
+    .unwrap();
+    let out = robosim()
+        .args(["check", "--db", dir.path().to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.contains("scenes.xml:3:5: error: <robot> in scene \"lost\": source \"no such robot\" is not a robot"), "{stdout}");
+}
