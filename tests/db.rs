@@ -624,3 +624,26 @@ fn renames_follow_references_and_deletes_check_them() {
             .all(|p| !p.message.contains("\"car\""))
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// Loading never panics: the default files with a random slice cut out, random bytes
+    /// spliced in, or both; whatever is left loads, with problems where it must.
+    #[test]
+    fn any_mangled_file_loads_without_panicking(
+        which in 0usize..3,
+        cut in (0.0f64..1.0, 0usize..200),
+        splice in prop::collection::vec(any::<u8>(), 0..40),
+    ) {
+        let kind = FileKind::ALL[which];
+        let mut bytes = std::fs::read(Path::new("data").join(kind.file_name())).unwrap();
+        let start = (cut.0 * bytes.len() as f64) as usize;
+        let end = (start + cut.1).min(bytes.len());
+        bytes.splice(start..end, splice);
+        let (db, problems, _dir) = load(&[(kind, &bytes)]);
+        // Every problem names the file it is about.
+        prop_assert!(problems.iter().all(|p| p.file.ends_with(".xml")));
+        let _ = db.check();
+    }
+}

@@ -44,6 +44,8 @@ pub struct Metrics {
     pub angular_momentum: f64,
     pub max_joint_gap: f64,
     pub contacts: usize,
+    /// The deepest contact penetration (0 when nothing overlaps).
+    pub max_penetration: f64,
 }
 
 /// A motor's applied torque in the last step, for plots.
@@ -284,6 +286,12 @@ impl Simulation {
             angular_momentum: self.world.angular_momentum(),
             max_joint_gap: self.world.max_joint_gap(),
             contacts: self.world.contacts().len(),
+            max_penetration: self
+                .world
+                .contacts()
+                .iter()
+                .map(|c| c.depth)
+                .fold(0.0, f64::max),
         }
     }
 
