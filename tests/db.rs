@@ -647,3 +647,27 @@ proptest! {
         let _ = db.check();
     }
 }
+
+#[test]
+fn a_database_is_dirty_only_between_an_edit_and_its_save() {
+    // The default files are hand-formatted, so their text differs from what a save writes:
+    // dirtiness must compare models, not text, or a fresh load would already ask to save.
+    let dir = tempfile::tempdir().unwrap();
+    for kind in FileKind::ALL {
+        let from = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data")
+            .join(kind.file_name());
+        std::fs::copy(from, dir.path().join(kind.file_name())).unwrap();
+    }
+    let (mut db, _) = Database::load(dir.path());
+    assert!(!db.is_dirty());
+    let density = db.model.bodies[0].density;
+    db.model.bodies[0].density = density + 1.0;
+    assert!(db.is_dirty());
+    db.model.bodies[0].density = density;
+    assert!(!db.is_dirty(), "an edit undone leaves nothing to save");
+    db.model.bodies[0].density = density + 1.0;
+    db.save(Overwrite::Never).unwrap();
+    assert!(!db.is_dirty());
+    assert_eq!(Database::load(dir.path()).0.model, db.model);
+}

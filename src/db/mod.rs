@@ -61,6 +61,8 @@ pub struct Database {
     pub dir: Option<PathBuf>,
     pub model: Model,
     loaded: [Loaded; 3],
+    /// The model as last loaded or saved: what "unsaved changes" are measured against.
+    clean: Model,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -183,6 +185,7 @@ impl Database {
             };
             db.loaded[kind.index()].lossy = skipped;
         }
+        db.clean = db.model.clone();
         db
     }
 
@@ -282,6 +285,7 @@ impl Database {
                 lossy: false,
             };
         }
+        self.clean = self.model.clone();
         Ok(())
     }
 
@@ -304,15 +308,10 @@ impl Database {
             .collect()
     }
 
-    /// Whether the model differs from what is on disk.
+    /// Whether the model has edits since it was loaded or saved. (Compared as records,
+    /// not as text: a hand-written file that we would format differently is not an edit.)
     pub fn is_dirty(&self) -> bool {
-        FileKind::ALL.iter().any(|&k| {
-            let text = self.render(k);
-            match &self.loaded[k.index()].bytes {
-                Some(bytes) => bytes != text.as_bytes(),
-                None => !self.collection_is_empty(k),
-            }
-        })
+        self.model != self.clean
     }
 }
 
