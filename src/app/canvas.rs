@@ -63,9 +63,25 @@ impl Grab {
     }
 }
 
+/// How this frame's canvas behaves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Mode {
+    /// Frame the bodies (a new scene was just shown).
+    pub fit: bool,
+    /// Paused at step 0: dragging a body moves its placement instead of grabbing it.
+    pub editing: bool,
+    /// What a primary click does while editing.
+    pub tool: super::tools::Tool,
+}
+
 pub struct Outcome {
     pub fitted: bool,
     pub selection_changed: bool,
+    /// While editing: the body (index into `sim.bodies`) being dragged, and where the
+    /// pointer asks its reference point to be.
+    pub moved: Option<(usize, Vec2)>,
+    /// While editing with a tool other than Select: the clicked world point.
+    pub tool_click: Option<Vec2>,
 }
 
 const BACKGROUND: Color32 = Color32::from_rgb(24, 26, 30);
@@ -84,17 +100,20 @@ pub fn show(
     ui: &mut egui::Ui,
     sim: Option<&mut Simulation>,
     camera: &mut Camera,
-    fit: bool,
+    mode: Mode,
     debug: &mut DebugDraw,
     grab: &mut Option<Grab>,
     selected: &mut Option<usize>,
 ) -> Outcome {
+    let Mode { fit, editing, tool } = mode;
     let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
     let rect = response.rect;
     painter.rect_filled(rect, 0.0, BACKGROUND);
     let mut outcome = Outcome {
         fitted: false,
         selection_changed: false,
+        moved: None,
+        tool_click: None,
     };
     let Some(sim) = sim else {
         painter.text(
@@ -120,8 +139,10 @@ pub fn show(
         camera.centre -= Vec2::new(d.x as f64, d.y as f64) / camera.zoom;
         debug.follow = false;
     }
+    // Following stops while editing: the view must hold still under the user's clicks.
     if debug.follow
         && !fit
+        && !editing
         && let Some(target) = follow_point(sim, *selected)
     {
         // Ease towards the target so that the view does not shake with the bodies.
@@ -137,13 +158,19 @@ pub fn show(
     let pointer_world = response
         .interact_pointer_pos()
         .map(|p| camera.to_world(rect, p));
-    if response.drag_started_by(egui::PointerButton::Primary) || response.clicked() {
+    let selecting = !editing || tool == super::tools::Tool::Select;
+    if editing && !selecting && response.clicked() {
+        outcome.tool_click = pointer_world;
+    }
+    let offset_id = response.id.with("placement drag offset");
+    if selecting && (response.drag_started_by(egui::PointerButton::Primary) || response.clicked()) {
         let hit = pointer_world.and_then(|p| body_at(sim, p));
         if *selected != hit {
             *selected = hit;
             outcome.selection_changed = true;
         }
         if response.drag_started_by(egui::PointerButton::Primary)
+            && !editing
             && let (Some(i), Some(p)) = (hit, pointer_world)
             && let Some(body) = sim.world.body(sim.bodies[i].handle)
             && !body.is_static()
@@ -157,6 +184,26 @@ pub fn show(
     }
     if let (Some(g), Some(p)) = (grab.as_mut(), pointer_world) {
         g.target = p;
+    }
+    // Editing (step 0, paused): dragging a body moves its placement in the files, keeping
+    // the grabbed point under the pointer.
+    if editing
+        && selecting
+        && let (Some(i), Some(p)) = (*selected, pointer_world)
+        && let Some(origin) = sim
+            .bodies
+            .get(i)
+            .and_then(|b| sim.world.body(b.handle))
+            .map(|b| b.origin())
+    {
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            ui.data_mut(|d| d.insert_temp(offset_id, p - origin));
+        } else if response.dragged_by(egui::PointerButton::Primary)
+            && response.drag_delta() != egui::Vec2::ZERO
+            && let Some(offset) = ui.data(|d| d.get_temp::<Vec2>(offset_id))
+        {
+            outcome.moved = Some((i, p - offset));
+        }
     }
     if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
         *grab = None;
@@ -237,6 +284,23 @@ pub fn show(
             let n = egui::vec2(c.normal.x as f32, c.normal.y as f32) * 12.0;
             painter.line_segment([p, p + n], Stroke::new(1.0, Color32::from_rgb(240, 90, 60)));
         }
+    }
+    if editing {
+        let hint = match tool {
+            super::tools::Tool::Select => {
+                "editing at step 0: drag a body to move it · Q / E rotate the selected body · Play runs"
+            }
+            super::tools::Tool::Joint => {
+                "joint tool: click a point where two bodies overlap to pin them there"
+            }
+        };
+        painter.text(
+            rect.left_top() + egui::vec2(8.0, 8.0),
+            egui::Align2::LEFT_TOP,
+            hint,
+            egui::FontId::proportional(13.0),
+            Color32::from_gray(170),
+        );
     }
     if let Some(g) = grab
         && let Some(body) = sim.world.body(g.body)
@@ -346,4 +410,151 @@ fn draw_grid(painter: &egui::Painter, rect: Rect, camera: &Camera) {
         );
         y += spacing;
     }
+}
+
+/// What the body editor did this frame.
+pub enum VertexEdit {
+    None,
+    /// The vertex list was changed (a drag, an added point).
+    Changed(Vec<[f64; 2]>),
+    /// A click asked for a vertex that would break the outline; why.
+    Refused(String),
+}
+
+/// The body editor's canvas: the vertex list as drawn (valid or not), handles to drag,
+/// a click on empty space adds a vertex there. Green when it is a usable convex polygon.
+pub fn edit_vertices(
+    ui: &mut egui::Ui,
+    vertices: &[[f64; 2]],
+    camera: &mut Camera,
+    fit: bool,
+    dragging: &mut Option<usize>,
+    snap_step: Option<f64>,
+) -> VertexEdit {
+    let snap = |v: f64| super::tools::snap(v, snap_step);
+    let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+    let rect = response.rect;
+    painter.rect_filled(rect, 0.0, BACKGROUND);
+    if fit {
+        let (mut min, mut max) = (Vec2::repeat(-40.0), Vec2::repeat(40.0));
+        for v in vertices {
+            min = min.inf(&Vec2::new(v[0], v[1]));
+            max = max.sup(&Vec2::new(v[0], v[1]));
+        }
+        let margin = (max - min) * 0.6;
+        camera.fit(rect, min - margin, max + margin);
+    }
+    draw_grid(&painter, rect, camera);
+    if response.dragged_by(egui::PointerButton::Secondary)
+        || response.dragged_by(egui::PointerButton::Middle)
+    {
+        let d = response.drag_delta();
+        camera.centre -= Vec2::new(d.x as f64, d.y as f64) / camera.zoom;
+    }
+    if let Some(hover) = response.hover_pos() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            camera.zoom_about(rect, hover, (scroll as f64 * 0.002).exp());
+        }
+    }
+    let to_screen = |v: &[f64; 2]| camera.to_screen(rect, Vec2::new(v[0], v[1]));
+    let points: Vec<Pos2> = vertices.iter().map(to_screen).collect();
+    let valid = {
+        let pts: Vec<Vec2> = vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect();
+        pe::ConvexPolygon::new(&pts)
+    };
+    let colour = if valid.is_ok() {
+        Color32::from_rgb(90, 200, 120)
+    } else {
+        Color32::from_rgb(230, 80, 70)
+    };
+    if valid.is_ok() {
+        painter.add(Shape::convex_polygon(
+            points.clone(),
+            colour.gamma_multiply(0.3),
+            Stroke::new(1.5, colour),
+        ));
+    } else if points.len() >= 2 {
+        painter.add(Shape::closed_line(points.clone(), Stroke::new(1.5, colour)));
+    }
+    // The origin: where a placement puts (x, y).
+    let origin = camera.to_screen(rect, Vec2::zeros());
+    painter.line_segment(
+        [origin - egui::vec2(8.0, 0.0), origin + egui::vec2(8.0, 0.0)],
+        Stroke::new(1.0, Color32::GRAY),
+    );
+    painter.line_segment(
+        [origin - egui::vec2(0.0, 8.0), origin + egui::vec2(0.0, 8.0)],
+        Stroke::new(1.0, Color32::GRAY),
+    );
+    let pointer = response.interact_pointer_pos();
+    let near = |p: Pos2| points.iter().position(|q| q.distance(p) < 8.0);
+    if response.drag_started_by(egui::PointerButton::Primary) {
+        *dragging = pointer.and_then(near);
+    }
+    let mut edit = VertexEdit::None;
+    if let (Some(i), Some(p)) = (*dragging, pointer)
+        && response.dragged_by(egui::PointerButton::Primary)
+    {
+        let w = camera.to_world(rect, p);
+        let mut new = vertices.to_vec();
+        new[i] = [snap(w.x), snap(w.y)];
+        if new != vertices {
+            edit = VertexEdit::Changed(new);
+        }
+    }
+    if response.drag_stopped() {
+        *dragging = None;
+    }
+    if response.clicked()
+        && let Some(p) = pointer
+        && near(p).is_none()
+    {
+        let w = camera.to_world(rect, p);
+        let point = [snap(w.x), snap(w.y)];
+        let anyway = ui.input(|i| i.modifiers.shift);
+        edit = match super::tools::add_vertex(vertices, point) {
+            Ok(new) => VertexEdit::Changed(new),
+            Err(_) if anyway && !vertices.contains(&point) => {
+                let mut new = vertices.to_vec();
+                new.push(point);
+                VertexEdit::Changed(new)
+            }
+            Err(why) => VertexEdit::Refused(why),
+        };
+    }
+    for (i, p) in points.iter().enumerate() {
+        painter.circle_filled(
+            *p,
+            5.0,
+            if Some(i) == *dragging {
+                Color32::YELLOW
+            } else {
+                Color32::WHITE
+            },
+        );
+        painter.text(
+            *p + egui::vec2(7.0, -7.0),
+            egui::Align2::LEFT_BOTTOM,
+            format!("{i}"),
+            egui::FontId::proportional(11.0),
+            Color32::GRAY,
+        );
+    }
+    let hint = match &valid {
+        Ok(_) => {
+            "click to add a vertex · drag a vertex to move it · the cross is the body's origin"
+                .to_string()
+        }
+        Err(_) if vertices.len() < 3 => "click to place vertices (at least three)".to_string(),
+        Err(e) => format!("{e} — keep adding vertices, or use Convex hull"),
+    };
+    painter.text(
+        rect.left_top() + egui::vec2(8.0, 8.0),
+        egui::Align2::LEFT_TOP,
+        hint,
+        egui::FontId::proportional(13.0),
+        colour,
+    );
+    edit
 }

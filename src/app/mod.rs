@@ -4,15 +4,18 @@
 
 pub mod camera;
 pub mod canvas;
-pub mod history;
+pub mod inspector;
+pub mod plot_data;
+pub mod tools;
+pub mod undo;
 
-use crate::db::{Database, Problem};
+use crate::db::{Database, Delete, Overwrite, Problem, SaveError};
 use crate::model::{Model, Scene, SceneRobot};
 use crate::sim::Simulation;
 use camera::Camera;
 use canvas::{DebugDraw, Grab};
-use history::History;
 use pe::ContactSolver;
+use plot_data::PlotData;
 use std::path::PathBuf;
 
 /// Runs the app in a native window until it is closed: on `db`, or the embedded default.
@@ -31,6 +34,7 @@ pub fn run(db: Option<PathBuf>) -> Result<(), String> {
             if let Some(storage) = cc.storage {
                 app.recent = eframe::get_value(storage, RECENT_KEY).unwrap_or_default();
             }
+            app.offer_restore();
             Ok(Box::new(app))
         }),
     )
@@ -64,14 +68,51 @@ pub struct RoboSimApp {
     /// Simulated time owed to the physics: real time × speed, paid in whole steps.
     accumulator: f64,
     pub debug: DebugDraw,
-    pub history: History,
+    pub plot_data: PlotData,
     /// Index into `sim.bodies` of the body the inspector and plots follow.
     pub selected_body: Option<usize>,
     grab: Option<Grab>,
     path_input: String,
     pub status: String,
+    /// Whether `status` reports a failure (red) rather than news (plain).
+    pub status_is_error: bool,
     show_problems: bool,
     pub recent: Vec<String>,
+    /// Undo and redo of model edits.
+    pub edits: undo::UndoHistory,
+    /// The selection's name as it is being typed (applied on Enter).
+    name_buffer: String,
+    /// A question waiting for the user's answer.
+    dialog: Option<Dialog>,
+    /// The vertex being dragged in the body editor.
+    vertex_drag: Option<usize>,
+    /// The window may close: the user answered the unsaved-changes question.
+    close_confirmed: bool,
+    /// What a click on the canvas does while editing.
+    pub tool: tools::Tool,
+    /// Grid spacing edits snap to (None: free).
+    pub snap_step: Option<f64>,
+    /// Where the canvas was drawn last frame (screen points), to map clicks to the world.
+    pub canvas_rect: egui::Rect,
+}
+
+/// Questions the app asks before doing something that cannot be undone.
+#[derive(Debug, Clone, PartialEq)]
+enum Dialog {
+    /// Saving would overwrite a file changed on disk or drop unreadable records.
+    Overwrite(String),
+    /// Unsaved changes and the window is closing, or another folder is opening.
+    Unsaved(AfterSave),
+    /// A delete refused because the item is used; offer the cascade.
+    Cascade(Selection, String),
+    /// Unsaved work from a session that did not end cleanly was found.
+    Restore(Model),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum AfterSave {
+    Quit,
+    Open(PathBuf),
 }
 
 impl RoboSimApp {
@@ -93,13 +134,22 @@ impl RoboSimApp {
             speed: 1.0,
             accumulator: 0.0,
             debug: DebugDraw::default(),
-            history: History::default(),
+            plot_data: PlotData::default(),
             selected_body: None,
             grab: None,
             path_input: dir.map(|d| d.display().to_string()).unwrap_or_default(),
             status: String::new(),
+            status_is_error: false,
             show_problems: false,
             recent: Vec::new(),
+            edits: undo::UndoHistory::default(),
+            name_buffer: String::new(),
+            dialog: None,
+            vertex_drag: None,
+            close_confirmed: false,
+            tool: tools::Tool::Select,
+            snap_step: Some(0.5),
+            canvas_rect: egui::Rect::NOTHING,
         };
         if let Some(first) = app.db.model.scenes.first().map(|s| s.name.clone()) {
             app.select(Selection::Scene(first));
@@ -132,25 +182,260 @@ impl RoboSimApp {
         match Simulation::new(&model, &scene, None, Some(solver)) {
             Ok(sim) => {
                 self.sim = Some(sim);
-                self.status.clear();
+                self.inform(String::new());
             }
             Err(e) => {
                 self.sim = None;
-                self.status = e.to_string();
+                self.complain(e.to_string());
             }
         }
         self.running = run;
+        self.name_buffer = match &selection {
+            Selection::Scene(n) | Selection::Robot(n) | Selection::Body(n) => n.clone(),
+        };
+        if !matches!(selection, Selection::Robot(_)) {
+            self.tool = tools::Tool::Select;
+        }
         self.selection = Some(selection);
+        self.selected_body = None;
         self.after_rebuild();
         self.camera_fitted = false;
+    }
+
+    /// Makes `draft` the model as one undoable edit (merged with the last if `key` is the
+    /// same field), re-checks it and rebuilds what the canvas shows, paused at step 0.
+    pub fn commit(&mut self, draft: Model, key: &str, now: f64) {
+        if draft == self.db.model {
+            return;
+        }
+        self.edits.record(&self.db.model, key, now);
+        self.db.model = draft;
+        self.model_changed();
+    }
+
+    fn model_changed(&mut self) {
+        self.problems = self.db.check();
+        // Keep the view across an edit, unless it had nothing to frame (a new, empty robot).
+        let had_bodies = self.sim.as_ref().is_some_and(|s| !s.bodies.is_empty());
+        let (camera, fitted, selected) = (
+            self.camera,
+            self.camera_fitted && had_bodies,
+            self.selected_body,
+        );
+        if let Some(sel) = self.selection.clone() {
+            let still_there = match &sel {
+                Selection::Scene(n) => self.db.model.scene(n).is_some(),
+                Selection::Robot(n) => self.db.model.robot(n).is_some(),
+                Selection::Body(n) => self.db.model.body(n).is_some(),
+            };
+            if still_there {
+                self.select(sel);
+                self.running = false;
+            } else {
+                self.selection = None;
+                self.sim = None;
+            }
+        }
+        (self.camera, self.camera_fitted, self.selected_body) = (camera, fitted, selected);
+    }
+
+    pub fn undo(&mut self) {
+        if self.edits.undo(&mut self.db.model) {
+            self.model_changed();
+        }
+    }
+
+    pub fn redo(&mut self) {
+        if self.edits.redo(&mut self.db.model) {
+            self.model_changed();
+        }
+    }
+
+    /// Saves to the database's folder (asking for one if it has none).
+    pub fn save(&mut self, overwrite: Overwrite) {
+        // Files saved by the editor always say their step (a file without one means 0.05 s,
+        // which a reader should not have to know).
+        for scene in &mut self.db.model.scenes {
+            scene.timestep.get_or_insert(crate::model::DEFAULT_TIMESTEP);
+        }
+        let result = match self.db.dir.clone() {
+            Some(_) => self.db.save(overwrite),
+            None => {
+                let typed = (!self.path_input.trim().is_empty())
+                    .then(|| PathBuf::from(self.path_input.trim()));
+                let Some(dir) = typed.or_else(|| {
+                    rfd::FileDialog::new()
+                        .set_title("Save the database in…")
+                        .pick_folder()
+                }) else {
+                    self.complain("choose a folder to save to (type it in the path field)".into());
+                    return;
+                };
+                self.db.save_to(&dir, overwrite)
+            }
+        };
+        match result {
+            Ok(()) => {
+                self.inform(format!(
+                    "saved to {}",
+                    self.db
+                        .dir
+                        .as_ref()
+                        .map_or(String::new(), |d| d.display().to_string())
+                ));
+                if let Some(dir) = &self.db.dir {
+                    self.path_input = dir.display().to_string();
+                }
+            }
+            Err(e @ (SaveError::ChangedOnDisk(_) | SaveError::WouldDropRecords(_))) => {
+                self.dialog = Some(Dialog::Overwrite(e.to_string()));
+            }
+            Err(e) => self.complain(e.to_string()),
+        }
+    }
+
+    /// Reloads the database from disk, dropping unsaved edits (undoable).
+    pub fn revert(&mut self) {
+        let Some(dir) = self.db.dir.clone() else {
+            return;
+        };
+        let (db, problems) = Database::load(&dir);
+        self.edits.record(&self.db.model, "revert", f64::NAN);
+        self.db = db;
+        self.problems = problems;
+        self.model_changed();
+    }
+
+    fn new_item(&mut self, kind: &str, now: f64) {
+        let mut draft = self.db.model.clone();
+        let selection = match kind {
+            "body" => {
+                let names: Vec<String> = draft.bodies.iter().map(|b| b.name.clone()).collect();
+                let name = inspector::unique(&names, "new body");
+                draft.bodies.push(crate::model::BodyDef {
+                    name: name.clone(),
+                    density: 1.0,
+                    cor: 0.2,
+                    vertices: vec![[-20.0, -10.0], [20.0, -10.0], [20.0, 10.0], [-20.0, 10.0]],
+                    ..Default::default()
+                });
+                Selection::Body(name)
+            }
+            "robot" => {
+                let names: Vec<String> = draft.robots.iter().map(|r| r.name.clone()).collect();
+                let name = inspector::unique(&names, "new robot");
+                draft.robots.push(crate::model::Robot {
+                    name: name.clone(),
+                    ..Default::default()
+                });
+                Selection::Robot(name)
+            }
+            _ => {
+                let names: Vec<String> = draft.scenes.iter().map(|s| s.name.clone()).collect();
+                let name = inspector::unique(&names, "new scene");
+                draft.scenes.push(Scene {
+                    name: name.clone(),
+                    gravitation: 200.0,
+                    friction: 0.5,
+                    timestep: Some(1.0 / 60.0),
+                    ..Scene::default()
+                });
+                Selection::Scene(name)
+            }
+        };
+        self.commit(draft, &format!("new {kind}"), now);
+        self.select(selection);
+        self.running = false;
+    }
+
+    fn duplicate(&mut self, now: f64) {
+        let Some(sel) = self.selection.clone() else {
+            return;
+        };
+        let mut draft = self.db.model.clone();
+        let selection = match sel {
+            Selection::Body(n) => {
+                let names: Vec<String> = draft.bodies.iter().map(|b| b.name.clone()).collect();
+                let Some(mut b) = draft.body(&n).cloned() else {
+                    return;
+                };
+                b.name = inspector::unique(&names, &format!("{n} copy"));
+                draft.bodies.push(b.clone());
+                Selection::Body(b.name)
+            }
+            Selection::Robot(n) => {
+                let names: Vec<String> = draft.robots.iter().map(|r| r.name.clone()).collect();
+                let Some(mut r) = draft.robot(&n).cloned() else {
+                    return;
+                };
+                r.name = inspector::unique(&names, &format!("{n} copy"));
+                draft.robots.push(r.clone());
+                Selection::Robot(r.name)
+            }
+            Selection::Scene(n) => {
+                let names: Vec<String> = draft.scenes.iter().map(|s| s.name.clone()).collect();
+                let Some(mut s) = draft.scene(&n).cloned() else {
+                    return;
+                };
+                s.name = inspector::unique(&names, &format!("{n} copy"));
+                draft.scenes.push(s.clone());
+                Selection::Scene(s.name)
+            }
+        };
+        self.commit(draft, "duplicate", now);
+        self.select(selection);
+    }
+
+    fn delete(&mut self, mode: Delete, now: f64) {
+        let Some(sel) = self.selection.clone() else {
+            return;
+        };
+        let mut draft = self.db.model.clone();
+        let result = match &sel {
+            Selection::Body(n) => draft.delete_body(n, mode),
+            Selection::Robot(n) => draft.delete_robot(n, mode),
+            Selection::Scene(n) => draft.delete_scene(n),
+        };
+        match result {
+            Ok(()) => self.commit(draft, "delete", now),
+            Err(e @ crate::db::EditError::InUse { .. }) => {
+                self.dialog = Some(Dialog::Cascade(sel, e.to_string()))
+            }
+            Err(e) => self.complain(e.to_string()),
+        }
+    }
+
+    fn rename(&mut self, sel: Selection, new: String, now: f64) {
+        let mut draft = self.db.model.clone();
+        let (result, renamed) = match &sel {
+            Selection::Body(n) => (draft.rename_body(n, &new), Selection::Body(new.clone())),
+            Selection::Robot(n) => (draft.rename_robot(n, &new), Selection::Robot(new.clone())),
+            Selection::Scene(n) => (draft.rename_scene(n, &new), Selection::Scene(new.clone())),
+        };
+        match result {
+            Ok(()) => {
+                self.commit(draft, "rename", now);
+                self.select(renamed);
+                self.running = false;
+            }
+            Err(e) => self.complain(format!("cannot rename: {e}")),
+        }
     }
 
     fn after_rebuild(&mut self) {
         self.accumulator = 0.0;
         self.grab = None;
-        self.history.clear();
+        self.plot_data.clear();
         if let Some(sim) = &self.sim {
-            self.history.record(sim, self.selected_body);
+            self.plot_data.record(sim, self.selected_body);
+        }
+    }
+
+    /// Back to step 0, paused: where the canvas edits placements and joints.
+    fn stop_at_start(&mut self) {
+        self.running = false;
+        if self.sim.as_ref().is_some_and(|s| s.step_count() > 0) {
+            self.reset();
         }
     }
 
@@ -168,7 +453,7 @@ impl RoboSimApp {
             grab.apply(sim);
         }
         sim.step();
-        self.history.record(sim, self.selected_body);
+        self.plot_data.record(sim, self.selected_body);
     }
 
     /// Advances by `frame_seconds` of real time at the chosen speed, in whole fixed steps.
@@ -189,6 +474,15 @@ impl RoboSimApp {
     }
 
     fn open(&mut self, dir: PathBuf) {
+        if self.db.is_dirty() {
+            self.dialog = Some(Dialog::Unsaved(AfterSave::Open(dir)));
+        } else {
+            self.open_now(dir);
+        }
+    }
+
+    fn open_now(&mut self, dir: PathBuf) {
+        self.edits.clear();
         let (db, problems) = Database::load(&dir);
         self.db = db;
         self.problems = problems;
@@ -230,6 +524,23 @@ impl RoboSimApp {
                 });
             }
             ui.separator();
+            let dirty = self.db.is_dirty();
+            if ui.add_enabled(dirty || self.db.dir.is_none(), egui::Button::new(if dirty { "Save*" } else { "Save" }))
+                .on_hover_text("Save the database, each file atomically (Ctrl+S)")
+                .clicked()
+            {
+                self.save(Overwrite::Never);
+            }
+            if ui.add_enabled(self.edits.can_undo(), egui::Button::new("Undo")).on_hover_text("Undo the last edit (Ctrl+Z)").clicked() {
+                self.undo();
+            }
+            if ui.add_enabled(self.edits.can_redo(), egui::Button::new("Redo")).on_hover_text("Redo (Ctrl+Shift+Z or Ctrl+Y)").clicked() {
+                self.redo();
+            }
+            if ui.add_enabled(self.db.dir.is_some() && dirty, egui::Button::new("Revert")).on_hover_text("Reload the files, dropping unsaved edits (undoable)").clicked() {
+                self.revert();
+            }
+            ui.separator();
             let label = if self.running { "Pause" } else { "Play" };
             if ui.button(label).on_hover_text("Start or stop the simulation (Space)").clicked() {
                 self.running = !self.running;
@@ -266,6 +577,32 @@ impl RoboSimApp {
                 sim.world.settings.contact_solver = self.solver;
             }
             ui.separator();
+            if matches!(self.selection, Some(Selection::Robot(_))) {
+                let joint = self.tool == tools::Tool::Joint;
+                if ui
+                    .selectable_label(joint, "Add joint")
+                    .on_hover_text("Pin two bodies together: click a point where they overlap (paused at step 0)")
+                    .clicked()
+                {
+                    self.tool = if joint { tools::Tool::Select } else { tools::Tool::Joint };
+                    if self.tool == tools::Tool::Joint {
+                        self.stop_at_start();
+                    }
+                }
+            }
+            egui::ComboBox::from_id_salt("snap")
+                .selected_text(match self.snap_step {
+                    Some(s) => format!("snap {s}"),
+                    None => "snap off".into(),
+                })
+                .show_ui(ui, |ui| {
+                    for step in tools::SNAP_STEPS {
+                        let label = step.map_or("off".to_string(), |s| s.to_string());
+                        ui.selectable_value(&mut self.snap_step, step, label);
+                    }
+                })
+                .response
+                .on_hover_text("Grid spacing that vertices, placements and joints snap to");
             ui.toggle_value(&mut self.debug.follow, "Follow").on_hover_text("Keep the moving bodies in view (panning turns it off)");
             ui.menu_button("Debug draw", |ui| {
                 ui.checkbox(&mut self.debug.contacts, "Contact points and normals");
@@ -280,6 +617,33 @@ impl RoboSimApp {
     }
 
     fn browser(&mut self, ui: &mut egui::Ui) {
+        let now = ui.input(|i| i.time);
+        ui.horizontal_wrapped(|ui| {
+            ui.menu_button("New", |ui| {
+                for kind in ["body", "robot", "scene"] {
+                    if ui.button(kind).clicked() {
+                        self.new_item(kind, now);
+                    }
+                }
+            })
+            .response
+            .on_hover_text("Create a body, robot or scene");
+            if ui
+                .add_enabled(self.selection.is_some(), egui::Button::new("Duplicate"))
+                .on_hover_text("Copy the selected item under a new name")
+                .clicked()
+            {
+                self.duplicate(now);
+            }
+            if ui
+                .add_enabled(self.selection.is_some(), egui::Button::new("Delete"))
+                .on_hover_text("Delete the selected item (refused while it is used)")
+                .clicked()
+            {
+                self.delete(Delete::IfUnused, now);
+            }
+        });
+        ui.separator();
         let mut chosen = None;
         egui::ScrollArea::vertical().show(ui, |ui| {
             let m = &self.db.model;
@@ -343,89 +707,25 @@ impl RoboSimApp {
     }
 
     fn inspector(&mut self, ui: &mut egui::Ui) {
-        ui.heading("Inspector");
-        match &self.selection {
-            Some(Selection::Scene(name)) => {
-                if let Some(s) = self.db.model.scene(name) {
-                    egui::Grid::new("scene").num_columns(2).show(ui, |ui| {
-                        ui.label("scene");
-                        ui.label(&s.name);
-                        ui.end_row();
-                        ui.label("gravitation");
-                        ui.label(format!("{} px/s²", s.gravitation));
-                        ui.end_row();
-                        ui.label("friction μ");
-                        ui.label(format!("{}", s.friction));
-                        ui.end_row();
-                        ui.label("timestep h");
-                        ui.label(format!(
-                            "{:.5} s{}",
-                            s.timestep(),
-                            if s.timestep.is_none() {
-                                " (default)"
-                            } else {
-                                ""
-                            }
-                        ));
-                        ui.end_row();
-                    });
-                }
-            }
-            Some(Selection::Body(name)) => {
-                if let Some(def) = self.db.model.body(name) {
-                    ui.label(format!("body \"{}\"", def.name));
-                    match crate::db::polygon(def) {
-                        Ok(poly) => {
-                            let mp = poly.mass_properties();
-                            egui::Grid::new("body").num_columns(2).show(ui, |ui| {
-                                for (k, v) in [
-                                    ("density", format!("{}", def.density)),
-                                    ("cor", format!("{}", def.cor)),
-                                    ("vertices", format!("{}", def.vertices.len())),
-                                    ("area", format!("{:.4}", mp.area)),
-                                    ("mass", format!("{:.4}", mp.area * def.density)),
-                                    (
-                                        "centroid",
-                                        format!("({:.3}, {:.3})", mp.centroid.x, mp.centroid.y),
-                                    ),
-                                    ("inertia", format!("{:.5e}", mp.second_moment * def.density)),
-                                ] {
-                                    ui.label(k);
-                                    ui.label(v);
-                                    ui.end_row();
-                                }
-                            });
-                        }
-                        Err(e) => {
-                            ui.colored_label(egui::Color32::LIGHT_RED, e.to_string());
-                        }
-                    }
-                }
-            }
-            Some(Selection::Robot(name)) => {
-                if let Some(r) = self.db.model.robot(name) {
-                    ui.label(format!("robot \"{}\"", r.name));
-                    for b in &r.bodies {
-                        let motors = if b.motors.is_empty() {
-                            String::new()
-                        } else {
-                            format!(" · {} motor(s)", b.motors.len())
-                        };
-                        ui.label(format!(
-                            "• {} ({}){motors}",
-                            b.placement.alias, b.placement.source
-                        ));
-                    }
-                    for j in &r.joints {
-                        let motor = if j.motor.is_some() { " · motor" } else { "" };
-                        ui.label(format!("⊙ {}–{}{motor}", j.body_a, j.body_b));
-                    }
-                }
-            }
-            None => {
+        let now = ui.input(|i| i.time);
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            ui.heading("Inspector");
+            let Some(sel) = self.selection.clone() else {
                 ui.label("Select a scene, robot or body.");
+                return;
+            };
+            let mut draft = self.db.model.clone();
+            let change = inspector::show(ui, &sel, &mut draft, &mut self.name_buffer);
+            if let Some((sel, new)) = change.rename {
+                self.rename(sel, new, now);
+            } else if let Some(key) = change.key {
+                self.commit(draft, &key, now);
             }
-        }
+            self.followed_body(ui);
+        });
+    }
+
+    fn followed_body(&mut self, ui: &mut egui::Ui) {
         ui.separator();
         let (Some(sim), Some(i)) = (&self.sim, self.selected_body) else {
             ui.label("Click a body on the canvas to follow it.");
@@ -460,7 +760,7 @@ impl RoboSimApp {
 
     fn plots(&mut self, ui: &mut egui::Ui) {
         use egui_plot::{Legend, Line, Plot};
-        let h = &self.history;
+        let h = &self.plot_data;
         ui.columns(3, |cols| {
             Plot::new("energy")
                 .legend(Legend::default())
@@ -499,6 +799,16 @@ impl RoboSimApp {
         });
     }
 
+    fn inform(&mut self, news: String) {
+        self.status = news;
+        self.status_is_error = false;
+    }
+
+    fn complain(&mut self, problem: String) {
+        self.status = problem;
+        self.status_is_error = true;
+    }
+
     fn status_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
             let errors = self.problems.iter().filter(|p| p.is_error()).count();
@@ -522,7 +832,11 @@ impl RoboSimApp {
                 ui.label(first.to_string());
             }
             if !self.status.is_empty() {
-                ui.colored_label(egui::Color32::LIGHT_RED, &self.status);
+                if self.status_is_error {
+                    ui.colored_label(egui::Color32::LIGHT_RED, &self.status);
+                } else {
+                    ui.label(&self.status);
+                }
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                 if let Some(sim) = &self.sim {
@@ -538,6 +852,318 @@ impl RoboSimApp {
                 }
             });
         });
+    }
+}
+
+impl RoboSimApp {
+    fn central(&mut self, ui: &mut egui::Ui, now: f64) {
+        self.canvas_rect = ui.available_rect_before_wrap();
+        let fit = !self.camera_fitted;
+        if let Some(Selection::Body(name)) = self.selection.clone() {
+            let vertices = self
+                .db
+                .model
+                .body(&name)
+                .map(|b| b.vertices.clone())
+                .unwrap_or_default();
+            match canvas::edit_vertices(
+                ui,
+                &vertices,
+                &mut self.camera,
+                fit,
+                &mut self.vertex_drag,
+                self.snap_step,
+            ) {
+                canvas::VertexEdit::Changed(new) => {
+                    let mut draft = self.db.model.clone();
+                    if let Some(b) = draft.bodies.iter_mut().find(|b| b.name == name) {
+                        b.vertices = new;
+                    }
+                    let key = format!("vertex {:?}", self.vertex_drag);
+                    self.inform(String::new());
+                    self.commit(draft, &key, now);
+                }
+                canvas::VertexEdit::Refused(why) => self.complain(why),
+                canvas::VertexEdit::None => {}
+            }
+            self.camera_fitted = true;
+            return;
+        }
+        let editing = !self.running && self.sim.as_ref().is_some_and(|s| s.step_count() == 0);
+        let outcome = canvas::show(
+            ui,
+            self.sim.as_mut(),
+            &mut self.camera,
+            canvas::Mode {
+                fit,
+                editing,
+                tool: self.tool,
+            },
+            &mut self.debug,
+            &mut self.grab,
+            &mut self.selected_body,
+        );
+        if outcome.fitted {
+            self.camera_fitted = true;
+        }
+        if outcome.selection_changed {
+            self.plot_data.clear();
+            if let Some(sim) = &self.sim {
+                self.plot_data.record(sim, self.selected_body);
+            }
+        }
+        if let Some((index, wanted)) = outcome.moved {
+            self.move_placement(index, wanted, now);
+        }
+        if let Some(p) = outcome.tool_click {
+            self.use_tool(p, now);
+        }
+        if editing
+            && let Some(i) = self.selected_body
+            && !ui.ctx().text_edit_focused()
+        {
+            let turn = ui
+                .input(|i| i.key_pressed(egui::Key::E) as i32 - i.key_pressed(egui::Key::Q) as i32);
+            if turn != 0 {
+                self.rotate_placement(i, turn as f64 * 15f64.to_radians(), now);
+            }
+        }
+    }
+
+    /// Applies the current tool at world point `p` (the robot preview puts the robot's
+    /// frame at the world origin, so world and robot coordinates agree).
+    fn use_tool(&mut self, p: pe::Vec2, now: f64) {
+        let (tools::Tool::Joint, Some(Selection::Robot(robot))) =
+            (self.tool, self.selection.clone())
+        else {
+            return;
+        };
+        let p = pe::Vec2::new(
+            tools::snap(p.x, self.snap_step),
+            tools::snap(p.y, self.snap_step),
+        );
+        let mut draft = self.db.model.clone();
+        match tools::add_joint(&mut draft, &robot, p) {
+            Ok(j) => {
+                self.inform(format!(
+                    "pinned {} to {} at ({}, {})",
+                    j.body_b, j.body_a, p.x, p.y
+                ));
+                self.commit(draft, "add joint", now);
+            }
+            Err(why) => self.complain(why),
+        }
+    }
+
+    /// Moves the placement behind simulated body `index` so that its reference point goes
+    /// to `wanted` (snapped to the grid): a scene body, a whole robot in a scene, or a body
+    /// within a robot.
+    fn move_placement(&mut self, index: usize, wanted: pe::Vec2, now: f64) {
+        let Some((id, origin)) = self.sim.as_ref().and_then(|s| {
+            let b = s.bodies.get(index)?;
+            Some((b.id.clone(), s.world.body(b.handle)?.origin()))
+        }) else {
+            return;
+        };
+        let snapped = pe::Vec2::new(
+            tools::snap(wanted.x, self.snap_step),
+            tools::snap(wanted.y, self.snap_step),
+        );
+        let delta = snapped - origin;
+        if delta.norm() < 1e-12 {
+            return;
+        }
+        self.edit_placement(&id, now, |x, y, _| {
+            *x += delta.x;
+            *y += delta.y;
+        });
+    }
+
+    /// Turns the placement behind simulated body `index` by `angle` about its origin.
+    fn rotate_placement(&mut self, index: usize, angle: f64, now: f64) {
+        let Some(id) = self
+            .sim
+            .as_ref()
+            .and_then(|s| s.bodies.get(index))
+            .map(|b| b.id.clone())
+        else {
+            return;
+        };
+        self.edit_placement(&id, now, |_, _, o| *o += angle);
+    }
+
+    /// Edits (x, y, orientation) of the placement that puts simulated body `id` where it is.
+    fn edit_placement(
+        &mut self,
+        id: &str,
+        now: f64,
+        edit: impl FnOnce(&mut f64, &mut f64, &mut f64),
+    ) {
+        let mut draft = self.db.model.clone();
+        match &self.selection {
+            Some(Selection::Scene(name)) => {
+                let Some(scene) = draft.scenes.iter_mut().find(|s| &s.name == name) else {
+                    return;
+                };
+                match id
+                    .split_once('/')
+                    .and_then(|(robot, _)| robot.rsplit_once('#'))
+                {
+                    Some((_, i)) => {
+                        let Some(r) = i
+                            .parse::<usize>()
+                            .ok()
+                            .and_then(|i| scene.robots.get_mut(i))
+                        else {
+                            return;
+                        };
+                        edit(&mut r.x, &mut r.y, &mut r.orientation);
+                    }
+                    None => {
+                        let Some(b) = scene.bodies.iter_mut().find(|b| b.alias == id) else {
+                            return;
+                        };
+                        edit(&mut b.x, &mut b.y, &mut b.orientation);
+                    }
+                }
+            }
+            Some(Selection::Robot(name)) => {
+                let Some(robot) = draft.robots.iter_mut().find(|r| &r.name == name) else {
+                    return;
+                };
+                let alias = id.split_once('/').map_or(id, |(_, a)| a);
+                let Some(b) = robot.bodies.iter_mut().find(|b| b.placement.alias == alias) else {
+                    return;
+                };
+                let p = &mut b.placement;
+                edit(&mut p.x, &mut p.y, &mut p.orientation);
+            }
+            _ => return,
+        }
+        self.commit(draft, &format!("place {id}"), now);
+    }
+
+    fn dialogs(&mut self, ctx: &egui::Context, now: f64) {
+        let Some(dialog) = self.dialog.clone() else {
+            return;
+        };
+        let mut close = false;
+        egui::Window::new("RoboSim")
+            .collapsible(false)
+            .resizable(false)
+            .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
+            .show(ctx, |ui| match &dialog {
+                Dialog::Overwrite(why) => {
+                    ui.label(why);
+                    ui.horizontal(|ui| {
+                        if ui.button("Overwrite").clicked() {
+                            close = true;
+                            self.save(Overwrite::Confirmed);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            close = true;
+                        }
+                    });
+                }
+                Dialog::Unsaved(after) => {
+                    ui.label("The database has unsaved changes.");
+                    ui.horizontal(|ui| {
+                        if ui.button("Save").clicked() {
+                            close = true;
+                            self.save(Overwrite::Never);
+                            if !self.db.is_dirty() {
+                                self.finish(after.clone(), ctx);
+                            }
+                        }
+                        if ui.button("Discard").clicked() {
+                            close = true;
+                            self.finish(after.clone(), ctx);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            close = true;
+                        }
+                    });
+                }
+                Dialog::Restore(model) => {
+                    ui.label(
+                        "Unsaved work from a session that ended unexpectedly was kept. Restore it?",
+                    );
+                    ui.horizontal(|ui| {
+                        if ui.button("Restore").clicked() {
+                            close = true;
+                            self.commit(model.clone(), "restore", now);
+                        }
+                        if ui.button("Discard it").clicked() {
+                            close = true;
+                            self.clear_autosave();
+                        }
+                    });
+                }
+                Dialog::Cascade(_, why) => {
+                    ui.label(why);
+                    ui.horizontal(|ui| {
+                        if ui.button("Delete it and its placements").clicked() {
+                            close = true;
+                            self.delete(Delete::Cascade, now);
+                        }
+                        if ui.button("Cancel").clicked() {
+                            close = true;
+                        }
+                    });
+                }
+            });
+        if close && self.dialog.as_ref() == Some(&dialog) {
+            self.dialog = None;
+        }
+    }
+
+    /// Where unsaved work is kept between saves (eframe's per-user data folder).
+    fn autosave_dir() -> Option<PathBuf> {
+        eframe::storage_dir("RoboSim").map(|d| d.join("autosave"))
+    }
+
+    /// Keeps a copy of unsaved work, to be offered back after a crash; called by eframe
+    /// every 30 s and on exit.
+    fn autosave(&mut self) {
+        let Some(dir) = Self::autosave_dir() else {
+            return;
+        };
+        if !self.db.is_dirty() || self.close_confirmed {
+            self.clear_autosave();
+            return;
+        }
+        let mut copy = Database::new(self.db.model.clone());
+        if copy.save_to(&dir, Overwrite::Confirmed).is_err() {
+            self.complain(format!("could not autosave to {}", dir.display()));
+        }
+    }
+
+    fn clear_autosave(&self) {
+        if let Some(dir) = Self::autosave_dir() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+
+    /// Offers back work autosaved by a session that ended without saving or discarding.
+    fn offer_restore(&mut self) {
+        let Some(dir) = Self::autosave_dir().filter(|d| d.is_dir()) else {
+            return;
+        };
+        let (saved, _) = Database::load(&dir);
+        if saved.model != self.db.model {
+            self.dialog = Some(Dialog::Restore(saved.model));
+        }
+    }
+
+    fn finish(&mut self, after: AfterSave, ctx: &egui::Context) {
+        match after {
+            AfterSave::Quit => {
+                self.close_confirmed = true;
+                self.clear_autosave();
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            AfterSave::Open(dir) => self.open_now(dir),
+        }
     }
 }
 
@@ -590,6 +1216,41 @@ impl eframe::App for RoboSimApp {
         if reset {
             self.reset();
         }
+        let now = ui.input(|i| i.time);
+        let (save, undo, redo, delete) = ui.input_mut(|i| {
+            let redo_y = i.consume_key(egui::Modifiers::COMMAND, egui::Key::Y);
+            let redo_z = i.consume_key(
+                egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+                egui::Key::Z,
+            );
+            (
+                i.consume_key(egui::Modifiers::COMMAND, egui::Key::S),
+                i.consume_key(egui::Modifiers::COMMAND, egui::Key::Z),
+                redo_y || redo_z,
+                !typing && i.key_pressed(egui::Key::Delete),
+            )
+        });
+        if save {
+            self.save(Overwrite::Never);
+        }
+        if undo && !typing {
+            self.undo();
+        }
+        if redo && !typing {
+            self.redo();
+        }
+        if delete {
+            self.delete(Delete::IfUnused, now);
+        }
+        // The unsaved-changes guard on quit.
+        if ui.input(|i| i.viewport().close_requested())
+            && !self.close_confirmed
+            && self.db.is_dirty()
+        {
+            ui.ctx()
+                .send_viewport_cmd(egui::ViewportCommand::CancelClose);
+            self.dialog = Some(Dialog::Unsaved(AfterSave::Quit));
+        }
         self.advance(frame_seconds);
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
@@ -605,27 +1266,8 @@ impl eframe::App for RoboSimApp {
             .resizable(true)
             .default_size(260.0)
             .show(ui, |ui| self.inspector(ui));
-        egui::CentralPanel::default().show(ui, |ui| {
-            let fit = !self.camera_fitted;
-            let outcome = canvas::show(
-                ui,
-                self.sim.as_mut(),
-                &mut self.camera,
-                fit,
-                &mut self.debug,
-                &mut self.grab,
-                &mut self.selected_body,
-            );
-            if outcome.fitted {
-                self.camera_fitted = true;
-            }
-            if outcome.selection_changed {
-                self.history.clear();
-                if let Some(sim) = &self.sim {
-                    self.history.record(sim, self.selected_body);
-                }
-            }
-        });
+        egui::CentralPanel::default().show(ui, |ui| self.central(ui, now));
+        self.dialogs(ui.ctx(), now);
         if self.show_problems {
             let mut open = true;
             egui::Window::new("Problems")
@@ -645,6 +1287,7 @@ impl eframe::App for RoboSimApp {
     }
 
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        self.autosave();
         eframe::set_value(storage, RECENT_KEY, &self.recent);
     }
 }

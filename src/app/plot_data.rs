@@ -18,14 +18,14 @@ pub struct Sample {
 /// Samples kept for the plots; the oldest half is thinned out when full, so a long run
 /// keeps its whole shape at half the resolution.
 #[derive(Debug, Clone, Default)]
-pub struct History {
+pub struct PlotData {
     pub samples: Vec<Sample>,
     pub motor_names: Vec<String>,
 }
 
 const CAPACITY: usize = 20_000;
 
-impl History {
+impl PlotData {
     pub fn clear(&mut self) {
         self.samples.clear();
         self.motor_names.clear();
