@@ -436,12 +436,13 @@ pub fn edit_vertices(
     let rect = response.rect;
     painter.rect_filled(rect, 0.0, BACKGROUND);
     if fit {
-        let (mut min, mut max) = (Vec2::repeat(-40.0), Vec2::repeat(40.0));
+        // At least a 40-unit square, so that an empty body has room to be drawn.
+        let (mut min, mut max) = (Vec2::repeat(-20.0), Vec2::repeat(20.0));
         for v in vertices {
             min = min.inf(&Vec2::new(v[0], v[1]));
             max = max.sup(&Vec2::new(v[0], v[1]));
         }
-        let margin = (max - min) * 0.6;
+        let margin = (max - min) * 0.4;
         camera.fit(rect, min - margin, max + margin);
     }
     draw_grid(&painter, rect, camera);

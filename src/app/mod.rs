@@ -721,7 +721,9 @@ impl RoboSimApp {
             } else if let Some(key) = change.key {
                 self.commit(draft, &key, now);
             }
-            self.followed_body(ui);
+            if !matches!(self.selection, Some(Selection::Body(_))) {
+                self.followed_body(ui);
+            }
         });
     }
 
@@ -761,10 +763,25 @@ impl RoboSimApp {
     fn plots(&mut self, ui: &mut egui::Ui) {
         use egui_plot::{Legend, Line, Plot};
         let h = &self.plot_data;
+        // At least a second of time axis, so that a run's first sample does not blow the
+        // x range up around a single point.
+        let t0 = h.samples.first().map_or(0.0, |s| s.time);
+        let body_title = match self
+            .selected_body
+            .and_then(|i| self.sim.as_ref()?.bodies.get(i))
+        {
+            Some(b) => format!("body {}: position, angle, velocity", b.id),
+            None => "click a body on the canvas to plot it".to_string(),
+        };
         ui.columns(3, |cols| {
+            cols[0].label("energy");
+            cols[1].label(body_title);
+            cols[2].label("motor torques, joint gap");
             Plot::new("energy")
                 .legend(Legend::default())
-                .height(150.0)
+                .height(136.0)
+                .include_x(t0)
+                .include_x(t0 + 1.0)
                 .show(&mut cols[0], |p| {
                     p.line(Line::new("kinetic", h.series(|s| Some(s.kinetic))));
                     p.line(Line::new("potential", h.series(|s| Some(s.potential))));
@@ -775,7 +792,9 @@ impl RoboSimApp {
                 });
             Plot::new("body")
                 .legend(Legend::default())
-                .height(150.0)
+                .height(136.0)
+                .include_x(t0)
+                .include_x(t0 + 1.0)
                 .show(&mut cols[1], |p| {
                     for (k, name) in ["x", "y", "angle", "vx", "vy", "ω"].iter().enumerate() {
                         p.line(Line::new(*name, h.series(|s| s.body.map(|b| b[k]))));
@@ -783,7 +802,9 @@ impl RoboSimApp {
                 });
             Plot::new("motors")
                 .legend(Legend::default())
-                .height(150.0)
+                .height(136.0)
+                .include_x(t0)
+                .include_x(t0 + 1.0)
                 .show(&mut cols[2], |p| {
                     for (k, name) in h.motor_names.iter().enumerate() {
                         p.line(Line::new(
@@ -1254,10 +1275,13 @@ impl eframe::App for RoboSimApp {
         self.advance(frame_seconds);
         egui::Panel::top("toolbar").show(ui, |ui| self.toolbar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
-        egui::Panel::bottom("plots")
-            .resizable(true)
-            .default_size(180.0)
-            .show(ui, |ui| self.plots(ui));
+        // A body on its own has nothing to plot: its editor gets the room.
+        if !matches!(self.selection, Some(Selection::Body(_))) {
+            egui::Panel::bottom("plots")
+                .resizable(true)
+                .default_size(180.0)
+                .show(ui, |ui| self.plots(ui));
+        }
         egui::Panel::left("browser")
             .resizable(true)
             .default_size(230.0)
