@@ -33,6 +33,8 @@ pub struct StepSettings {
     /// A typical body size in the world's length unit (1 for metre-sized bodies).
     pub length_scale: f64,
     pub joint_solver: JointSolver,
+    /// Islands with more LCP rows than this are solved iteratively rather than by pivoting.
+    pub dense_row_limit: usize,
 }
 
 impl Default for StepSettings {
@@ -42,6 +44,7 @@ impl Default for StepSettings {
             contact_solver: ContactSolver::default(),
             length_scale: 1.0,
             joint_solver: JointSolver::default(),
+            dense_row_limit: crate::solver::simultaneous::DENSE_ROW_LIMIT,
         }
     }
 }
@@ -742,6 +745,7 @@ impl World {
                 } else {
                     FrictionModel::Coupled
                 };
+                s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
                 s.simultaneous.solve(
                     model,
                     &mut self.contacts,
@@ -763,6 +767,7 @@ impl World {
             );
         }
         if solver == ContactSolver::Exact {
+            s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
             s.simultaneous.separate(
                 &self.contacts,
                 &s.joint_constraints,

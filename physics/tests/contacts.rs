@@ -312,7 +312,10 @@ fn a_stack_of_fifteen_with_random_offsets_stands_ten_seconds() {
             let body = w.body(b).unwrap();
             let slide = (body.position.x - start[i].x).abs();
             assert!(slide < 0.01, "{solver:?}: box {i} slid {slide}");
-            assert!(body.angle.abs() < 1f64.to_radians(), "{solver:?}: box {i} tipped");
+            assert!(
+                body.angle.abs() < 1f64.to_radians(),
+                "{solver:?}: box {i} tipped"
+            );
         }
         // The thesis's separate push-apart and two-stage friction leave the tall stack
         // trembling at about a fifth of g·h (0.037 measured); the coupled model comes to
@@ -347,7 +350,11 @@ fn a_heavy_wide_box_rests_on_two_small_ones() {
         assert!(moved < 0.01, "{solver:?}: the heavy box moved {moved}");
         for small in [left, right] {
             let b = w.body(small).unwrap();
-            assert!(b.angle.abs() < 1e-3, "{solver:?}: a small box tipped by {}", b.angle);
+            assert!(
+                b.angle.abs() < 1e-3,
+                "{solver:?}: a small box tipped by {}",
+                b.angle
+            );
         }
         let slop = w.settings.slop();
         assert!(
@@ -385,11 +392,17 @@ fn a_friction_ramp_stops_the_rough_boxes_and_slides_the_smooth_ones() {
                 .at(base + normal * 0.25, theta);
             boxes.push((mu, w.add_body(body).unwrap()));
         }
-        let starts: Vec<Vec2> = boxes.iter().map(|&(_, b)| w.body(b).unwrap().position).collect();
+        let starts: Vec<Vec2> = boxes
+            .iter()
+            .map(|&(_, b)| w.body(b).unwrap().position)
+            .collect();
         for _ in 0..30 {
             w.step(H);
         }
-        let v0: Vec<f64> = boxes.iter().map(|&(_, b)| w.body(b).unwrap().velocity.norm()).collect();
+        let v0: Vec<f64> = boxes
+            .iter()
+            .map(|&(_, b)| w.body(b).unwrap().velocity.norm())
+            .collect();
         for _ in 0..120 {
             w.step(H);
         }

@@ -10,7 +10,9 @@ use super::lcp::{LcpProblem, LcpSolver};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
-/// dense pivoting method, whose cost grows as n³.
+/// dense pivoting method, whose cost grows as n³. Measured by `examples/dense_threshold.rs`
+/// (README, Physics): where the pivoting solve starts costing more than the whole rest of
+/// a step.
 pub const DENSE_ROW_LIMIT: usize = 96;
 
 /// What happened in one island during the last step.
@@ -58,6 +60,8 @@ pub struct SimultaneousSolver {
     x: Vec<f64>,
     lcp: LcpSolver,
     pub reports: Vec<IslandReport>,
+    /// `StepSettings::dense_row_limit`, copied in before each solve.
+    pub dense_row_limit: usize,
 }
 
 impl SimultaneousSolver {
@@ -275,7 +279,7 @@ impl SimultaneousSolver {
             hi: &self.hi,
             friction_index: Some(&self.friction_index),
         };
-        let pivoting = n <= DENSE_ROW_LIMIT;
+        let pivoting = n <= self.dense_row_limit;
         let stats = if pivoting {
             self.lcp.solve(&problem, &mut self.x)
         } else {
