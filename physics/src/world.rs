@@ -365,6 +365,7 @@ impl World {
         loop {
             self.save_state();
             let h = dt / substeps as f64;
+            self.for_each_motor(|m| m.step_impulse = 0.0);
             for _ in 0..substeps {
                 self.correct_joint_velocities(h);
                 self.integrate_velocities(h);
@@ -373,6 +374,11 @@ impl World {
                 self.solve_constraints(h);
                 self.place_bounces_at_impact(h);
                 self.integrate_positions(h);
+                self.for_each_motor(|m| {
+                    if m.enabled {
+                        m.step_impulse += m.last_impulse;
+                    }
+                });
             }
             // A whip can spin links up within the step; if they now turn too far per
             // substep, this step's joint prediction was not trustworthy: redo it finer.
@@ -388,6 +394,14 @@ impl World {
         }
         self.clear_forces();
         self.step_count += 1;
+    }
+
+    fn for_each_motor(&mut self, f: impl Fn(&mut JointMotor)) {
+        self.joints
+            .iter_mut()
+            .flatten()
+            .filter_map(|j| j.motor.as_mut())
+            .for_each(f);
     }
 
     fn save_state(&mut self) {

@@ -296,12 +296,7 @@ fn joint_motor_drives_relative_speed_and_conserves_angular_momentum() {
         )
         .unwrap();
     let mut def = JointDef::new(a, Some(b), Vec2::new(0.9, 0.0));
-    def.motor = Some(JointMotor {
-        target_speed: 2.0,
-        max_torque: 5.0,
-        enabled: true,
-        last_impulse: 0.0,
-    });
+    def.motor = Some(JointMotor::new(2.0, 5.0));
     world.add_joint(def).unwrap();
     for _ in 0..600 {
         world.step(1.0 / 120.0);
@@ -321,4 +316,51 @@ fn joint_motor_drives_relative_speed_and_conserves_angular_momentum() {
         "L = {}",
         world.angular_momentum()
     );
+}
+
+#[test]
+fn a_joint_motor_reports_the_impulse_of_the_whole_step() {
+    // A square pinned at its centre to the world: only the motor turns it, so each step's
+    // change of angular momentum is the motor's impulse. At 100 rad/s the body turns
+    // 1.7 rad per 1/60 s step and the world splits the step into substeps; the reported
+    // impulse must be their sum, not the last substep's.
+    let dt = 1.0 / 60.0;
+    for solver in [
+        pe::ContactSolver::Exact,
+        pe::ContactSolver::Thesis,
+        pe::ContactSolver::Soft,
+    ] {
+        let mut world = World::new(Vec2::new(0.0, 0.0));
+        world.settings.contact_solver = solver;
+        let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        let body = world.add_body(BodyDef::new(square, 1.0)).unwrap();
+        let inertia = world.body(body).unwrap().inertia();
+        let mut def = JointDef::new(body, None, Vec2::zeros());
+        def.motor = Some(JointMotor::new(100.0, 20.0));
+        let joint = world.add_joint(def).unwrap();
+        let mut saturated = 0;
+        for _ in 0..300 {
+            let before = inertia * world.body(body).unwrap().angular_velocity;
+            world.step(dt);
+            let after = inertia * world.body(body).unwrap().angular_velocity;
+            let reported = world.joint(joint).unwrap().motor.unwrap().step_impulse;
+            assert!(
+                (after - before - reported).abs() < 1e-9,
+                "{solver:?}: reported {reported}, applied {}",
+                after - before
+            );
+            assert!(
+                reported.abs() <= 20.0 * dt * (1.0 + 1e-12),
+                "{solver:?}: {reported}"
+            );
+            saturated += usize::from(reported >= 20.0 * dt * (1.0 - 1e-12));
+        }
+        let omega = world.body(body).unwrap().angular_velocity;
+        assert!((omega - 100.0).abs() < 1e-6, "{solver:?}: ω = {omega}");
+        // I·100 rad/s = 16.7 takes 0.83 s (50 steps) at the full 20 N·m.
+        assert!(
+            (45..=55).contains(&saturated),
+            "{solver:?}: {saturated} steps at full torque"
+        );
+    }
 }

@@ -214,10 +214,8 @@ impl Simulation {
                 let mut motor_window = None;
                 if let Some(m) = &j.motor {
                     def.motor = Some(JointMotor {
-                        target_speed: m.angular / self.dt,
-                        max_torque: m.max_torque,
                         enabled: (m.time0..m.time1).contains(&0),
-                        last_impulse: 0.0,
+                        ..JointMotor::new(m.angular / self.dt, m.max_torque)
                     });
                     motor_window = Some((m.time0, m.time1, m.angular));
                 }
@@ -312,7 +310,7 @@ impl Simulation {
             if let Some(m) = self.world.joint(j.handle).and_then(|j| j.motor) {
                 out.push(MotorTorque {
                     id: j.id.clone(),
-                    torque: m.last_impulse / self.dt,
+                    torque: m.step_impulse / self.dt,
                 });
             }
         }

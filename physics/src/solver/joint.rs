@@ -57,8 +57,23 @@ pub struct JointMotor {
     pub target_speed: f64,
     pub max_torque: f64,
     pub enabled: bool,
-    /// Angular impulse the motor applied in the last step (torque = impulse / h).
+    /// Angular impulse of the motor's last solve (one substep's worth).
     pub last_impulse: f64,
+    /// Angular impulse the motor applied over the whole last step, all substeps summed:
+    /// the mean torque of the step is `step_impulse / h`.
+    pub step_impulse: f64,
+}
+
+impl JointMotor {
+    pub fn new(target_speed: f64, max_torque: f64) -> Self {
+        Self {
+            target_speed,
+            max_torque,
+            enabled: true,
+            last_impulse: 0.0,
+            step_impulse: 0.0,
+        }
+    }
 }
 
 /// How hard the joint passes iterate (SPEC §3.3 Rec: Gauss–Seidel with a tolerance and a cap).

@@ -113,6 +113,8 @@ struct SoftJoint {
     base_gap: Vec2,
     impulse: Vec2,
     motor_impulse: f64,
+    /// The motor's angular impulse summed over this step's substeps.
+    motor_step_total: f64,
     motor: Option<(f64, f64)>,
     slot: u32,
 }
@@ -171,6 +173,11 @@ impl SoftStepSolver {
                 settings.max_push_speed,
                 false,
             );
+            // Warm starting re-applies the accumulated impulse in every substep, so the
+            // step's total is the sum of the substeps' accumulated values.
+            for j in &mut self.joints {
+                j.motor_step_total += j.motor_impulse;
+            }
         }
         self.restitution(bounce_below);
         self.store(bodies, contacts, joints);
@@ -239,6 +246,7 @@ impl SoftStepSolver {
                 base_gap: (a.position + r_a) - (b.position + r_b) - j.gap_target,
                 impulse,
                 motor_impulse,
+                motor_step_total: 0.0,
                 motor: j
                     .motor
                     .filter(|m| m.enabled)
@@ -365,6 +373,7 @@ impl SoftStepSolver {
             self.joint_memory.push((j.slot, j.impulse, j.motor_impulse));
             if let Some(m) = c.motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
+                m.step_impulse = j.motor_step_total;
             }
         }
         self.joint_memory.sort_unstable_by_key(|x| x.0);
