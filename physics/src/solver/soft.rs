@@ -131,6 +131,9 @@ pub struct SoftStepSolver {
     joint_memory: Vec<(u32, Vec2, f64)>,
 }
 
+/// The most a body may turn in one substep (radians).
+const MAX_TURN_PER_SUBSTEP: f64 = 0.25 * std::f64::consts::PI;
+
 fn rotate_delta(q: Rot, r: Vec2) -> Vec2 {
     q.apply(r)
 }
@@ -263,6 +266,11 @@ impl SoftStepSolver {
             }
             b.v += lin * h;
             b.w += ang * h;
+            // A body turning more than a quarter turn per substep is beyond what the
+            // linearised rotation below (and any contact found at the step's start) can
+            // follow; like Box2D, cap the spin there rather than let it overflow to NaN.
+            let max_w = MAX_TURN_PER_SUBSTEP / h;
+            b.w = b.w.clamp(-max_w, max_w);
         }
     }
 

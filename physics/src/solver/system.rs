@@ -118,12 +118,14 @@ pub fn velocity_rows(
             friction_of: None,
         };
         let v_n = row.velocity(bodies);
-        row.b = if !c.meets_this_step(targets.dt) {
-            // Speculative: still apart after this step, so they may approach by the gap.
-            v_n - c.depth / targets.dt
-        } else if c.bounces(targets.dt, targets.bounce_below) {
+        row.b = if c.bounces(targets.dt, targets.bounce_below) {
             // (19): v_n' ≥ −e·v_n, with v_n the approach before this step's forces.
             v_n + c.restitution * c.approach_velocity.min(0.0)
+        } else if c.depth < 0.0 {
+            // Apart: they may approach by the gap this step, and no further. (Stopping
+            // them where they are would leave a body hovering up to g·h² above the
+            // ground: 3 mm at 60 Hz, three body sizes for a 1 mm part.)
+            v_n - c.depth / targets.dt
         } else {
             v_n
         };
