@@ -1,0 +1,326 @@
+//! Times `pe` (contact solvers `exact` and `soft`) against rapier2d on scenes with known
+//! answers, and writes the results as Markdown to docs/bench/results.md.
+//!
+//! Run with `cargo run --release` inside bench/.
+
+mod harness;
+mod pe_scenes;
+mod rapier_scenes;
+mod scene;
+
+use harness::{RUN_BUDGET, Timing, WARMUP_STEPS, WARMUP_WALL};
+use pe::ContactSolver;
+use scene::{Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain};
+use std::fmt::Write as _;
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// One engine's run of one scene.
+#[derive(Debug, Clone, Copy)]
+pub struct Outcome {
+    pub timing: Timing,
+    pub metric: Metric,
+}
+
+impl Outcome {
+    pub fn new(timing: Timing, metric: Metric) -> Self {
+        Self { timing, metric }
+    }
+}
+
+/// The pe solvers compared; rapier2d is the reference for the time ratios.
+const PE_SOLVERS: [ContactSolver; 2] = [ContactSolver::Exact, ContactSolver::Soft];
+
+/// One scene in every engine.
+struct Row {
+    scene: String,
+    known: String,
+    /// In the order of `PE_SOLVERS`.
+    pe: Vec<Outcome>,
+    rapier: Outcome,
+}
+
+/// Runs one scene in each pe solver and in rapier2d, reporting progress on stderr (the
+/// whole benchmark takes a few minutes).
+fn run_row(
+    scene: &str,
+    known: String,
+    pe_run: impl Fn(ContactSolver) -> Outcome,
+    rapier_run: impl Fn() -> Outcome,
+) -> Row {
+    let started = Instant::now();
+    eprint!("{scene}:");
+    let pe: Vec<Outcome> = PE_SOLVERS
+        .iter()
+        .map(|&s| {
+            eprint!(" pe {}…", s.name());
+            pe_run(s)
+        })
+        .collect();
+    eprint!(" rapier2d…");
+    let rapier = rapier_run();
+    eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
+    for o in &pe {
+        if o.timing.cut_short() {
+            eprintln!(
+                "  (a pe run stopped after {} steps: budget)",
+                o.timing.steps_run
+            );
+        }
+    }
+    Row {
+        scene: scene.to_string(),
+        known,
+        pe,
+        rapier,
+    }
+}
+
+fn main() {
+    let load = load_average();
+    let started = Instant::now();
+    let mut rows = Vec::new();
+    for spec in &PYRAMIDS {
+        rows.push(run_row(
+            spec.name,
+            "stands: drift 0, 0 fallen".into(),
+            |s| pe_scenes::pyramid(s, spec),
+            || rapier_scenes::pyramid(spec),
+        ));
+    }
+    for spec in &PENDULUMS {
+        rows.push(run_row(
+            spec.name,
+            format!("T = {:.5} s, ΔE = 0", Pendulum::exact_period()),
+            |s| pe_scenes::pendulum(s, spec),
+            || rapier_scenes::pendulum(spec),
+        ));
+    }
+    rows.push(run_row(
+        chain::NAME,
+        "gap 0".into(),
+        pe_scenes::heavy_chain,
+        rapier_scenes::heavy_chain,
+    ));
+    rows.push(run_row(
+        bounce::NAME,
+        format!("peak e²·h = {} m", bounce::expected_peak()),
+        pe_scenes::bounce,
+        rapier_scenes::bounce,
+    ));
+    let report = report(&rows, started.elapsed(), &load);
+    println!("{report}");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench/results.md");
+    if let Err(e) = std::fs::write(path, &report) {
+        eprintln!("could not write {path}: {e}");
+        std::process::exit(1);
+    }
+    eprintln!("written to docs/bench/results.md");
+}
+
+/// A duration with three significant figures in a readable unit.
+fn pretty(d: Duration) -> String {
+    let s = d.as_secs_f64();
+    let (value, unit) = match s {
+        s if s < 1e-3 => (s * 1e6, "µs"),
+        s if s < 1.0 => (s * 1e3, "ms"),
+        s => (s, "s"),
+    };
+    match value {
+        v if v < 10.0 => format!("{v:.2} {unit}"),
+        v if v < 100.0 => format!("{v:.1} {unit}"),
+        v => format!("{v:.0} {unit}"),
+    }
+}
+
+/// A time cell: the median, flagged when the run was cut short by the budget.
+fn time_cell(t: &Timing) -> String {
+    if t.cut_short() {
+        format!("{} † ({} timed)", pretty(t.median), t.timed_steps)
+    } else {
+        pretty(t.median)
+    }
+}
+
+/// A metric cell, flagged with how much of the scene was simulated when cut short.
+fn metric_cell(o: &Outcome) -> String {
+    if o.timing.cut_short() {
+        format!(
+            "{} † (after {} of {} steps)",
+            o.metric, o.timing.steps_run, o.timing.planned
+        )
+    } else {
+        o.metric.to_string()
+    }
+}
+
+fn ratio(pe: Duration, rapier: Duration) -> String {
+    let r = pe.as_secs_f64() / rapier.as_secs_f64();
+    if r < 100.0 {
+        format!("{r:.2}")
+    } else {
+        format!("{r:.0}")
+    }
+}
+
+fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
+    let names: Vec<&str> = PE_SOLVERS.iter().map(|s| s.name()).collect();
+    let mut md = String::new();
+    let w = &mut md;
+    // Writing to a String cannot fail.
+    let _ = writeln!(w, "# pe vs rapier2d\n");
+    let _ = writeln!(w, "- Machine: {}; load average at start: {load}", machine());
+    let _ = writeln!(w, "- Date: {} (UTC)", today());
+    let _ = writeln!(
+        w,
+        "- Engines: pe (this repository, f64) with contact solvers `{}`; rapier2d {} \
+         (f32, default features, one thread), default `IntegrationParameters` except `dt`, \
+         every body with `can_sleep(false)`.",
+        names.join("` and `"),
+        rapier_version()
+    );
+    let _ = writeln!(
+        w,
+        "- Timing: each step timed alone with `std::time::Instant`; the first \
+         {WARMUP_STEPS} steps of a run are a warm-up, simulated but not timed (only those \
+         ending within the run's first {} s, so a run of multi-second steps is timed from \
+         its first step); the figure is the median of the timed steps (mean of the middle \
+         two for an even count). Release build.",
+        WARMUP_WALL.as_secs()
+    );
+    let _ = writeln!(
+        w,
+        "- Budget: a run starts no new step after {} s of wall time once one step is timed; \
+         runs cut short are marked †, and their metric covers only the steps run.",
+        RUN_BUDGET.as_secs()
+    );
+    let _ = writeln!(
+        w,
+        "- Step h = 1/60 s except where the scene says; g = 10 m/s². pyramid40 is planned \
+         for 300 steps (5 s) instead of 600 to bound the run time; the pendulums run 60 s."
+    );
+    let _ = writeln!(w, "- Whole benchmark: {:.0} s.\n", elapsed.as_secs_f64());
+
+    let _ = writeln!(w, "## Time per step (median)\n");
+    let mut header = String::from("| scene | steps planned (timed) |");
+    let mut rule = String::from("|---|---:|");
+    for n in &names {
+        let _ = write!(header, " pe {n} |");
+        rule.push_str("---:|");
+    }
+    header.push_str(" rapier2d |");
+    rule.push_str("---:|");
+    for n in &names {
+        let _ = write!(header, " pe {n} ÷ rapier2d |");
+        rule.push_str("---:|");
+    }
+    let _ = writeln!(w, "{header}\n{rule}");
+    for r in rows {
+        let t = &r.rapier.timing;
+        let _ = write!(w, "| {} | {} ({}) |", r.scene, t.planned, t.timed_steps);
+        for o in &r.pe {
+            let _ = write!(w, " {} |", time_cell(&o.timing));
+        }
+        let _ = write!(w, " {} |", time_cell(t));
+        for o in &r.pe {
+            let _ = write!(w, " {} |", ratio(o.timing.median, t.median));
+        }
+        let _ = writeln!(w);
+    }
+
+    let _ = writeln!(w, "\n## Accuracy and stability\n");
+    let mut header = String::from("| scene | known answer |");
+    let mut rule = String::from("|---|---|");
+    for n in &names {
+        let _ = write!(header, " pe {n} |");
+        rule.push_str("---|");
+    }
+    header.push_str(" rapier2d |");
+    rule.push_str("---|");
+    let _ = writeln!(w, "{header}\n{rule}");
+    for r in rows {
+        let _ = write!(w, "| {} | {} |", r.scene, r.known);
+        for o in &r.pe {
+            let _ = write!(w, " {} |", metric_cell(o));
+        }
+        let _ = writeln!(w, " {} |", metric_cell(&r.rapier));
+    }
+    let _ = writeln!(
+        w,
+        "\nMetrics: pyramids — the top box's sideways displacement over the run in box \
+         widths, and how many boxes ever moved more than half a box vertically; pendulums — \
+         period from upward zero crossings of x against the exact compound-pendulum period, \
+         and max |E − E0| / (m g L); heavychain — widest joint gap at any step (link \
+         length 1 m); bounce — first rebound peak of the box's bottom against e²·h."
+    );
+    md
+}
+
+/// The 1-, 5- and 15-minute load averages: other work on the machine slows every engine.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// CPU model and logical core count, from /proc/cpuinfo (Linux).
+fn machine() -> String {
+    let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
+        return "unknown (no /proc/cpuinfo)".into();
+    };
+    let model = info
+        .lines()
+        .find_map(|l| l.strip_prefix("model name")?.split_once(':'))
+        .map_or("unknown CPU", |(_, m)| m.trim());
+    let cores = info.lines().filter(|l| l.starts_with("processor")).count();
+    format!("{model}, {cores} logical cores")
+}
+
+/// The rapier2d version actually built, from this crate's lock file.
+fn rapier_version() -> &'static str {
+    let lock = include_str!("../Cargo.lock");
+    lock.split("[[package]]")
+        .find(|p| p.contains("name = \"rapier2d\""))
+        .and_then(|p| p.lines().find_map(|l| l.strip_prefix("version = ")))
+        .map_or("(unknown version)", |v| v.trim_matches('"'))
+}
+
+/// Today's date (UTC) as YYYY-MM-DD, without a date library: days since 1970 to the
+/// proleptic Gregorian calendar (H. Hinnant's `civil_from_days`).
+fn today() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+fn civil_from_days(days: i64) -> (i64, u32, u32) {
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn civil_dates() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(20_454), (2026, 1, 1));
+    }
+
+    #[test]
+    fn the_lock_file_names_rapier() {
+        assert!(rapier_version().starts_with("0."));
+    }
+}

@@ -1,0 +1,142 @@
+//! The scenes built in `pe`. pe's y axis points down (gravity is +y), so every scene point
+//! (x, y up) becomes (x, −y) here.
+
+use crate::Outcome;
+use crate::harness::measure;
+use crate::scene::{
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
+    ReboundTracker, bounce, chain, worst,
+};
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, JointDef, JointHandle, Vec2, World};
+
+/// A scene point (y up) in pe's y-down world.
+fn at((x, y): (f64, f64)) -> Vec2 {
+    Vec2::new(x, -y)
+}
+
+/// A body's centre as a scene point (y up).
+fn centre(world: &World, body: BodyHandle) -> (f64, f64) {
+    let p = world.body(body).expect("bodies are never removed").position;
+    (p.x, -p.y)
+}
+
+fn world(solver: ContactSolver) -> World {
+    let mut w = World::new(Vec2::new(0.0, G));
+    w.settings.contact_solver = solver;
+    // All bodies are metre-sized: pe's tolerances (contact margin, slop, joint tolerance)
+    // scale with this.
+    w.settings.length_scale = 1.0;
+    w.friction = FRICTION;
+    w
+}
+
+fn rectangle(w: f64, h: f64) -> ConvexPolygon {
+    ConvexPolygon::rectangle(w, h).expect("positive sizes")
+}
+
+/// The static floor, top face at y = 0. Restitution 1 because pe combines a pair's
+/// restitutions by their minimum: the moving body's own value then applies.
+fn floor(w: &mut World) {
+    let def = BodyDef::new(rectangle(FLOOR.0, FLOOR.1), 0.0)
+        .restitution(1.0)
+        .at(at((0.0, -0.5 * FLOOR.1)), 0.0);
+    w.add_body(def).expect("valid floor");
+}
+
+pub fn pyramid(solver: ContactSolver, spec: &Pyramid) -> Outcome {
+    let mut w = world(solver);
+    floor(&mut w);
+    let unit = rectangle(BOX, BOX);
+    let centres = spec.centres();
+    let boxes: Vec<BodyHandle> = centres
+        .iter()
+        .map(|&c| {
+            w.add_body(BodyDef::new(unit.clone(), 1.0).at(at(c), 0.0))
+                .expect("valid box")
+        })
+        .collect();
+    let mut tracker = PyramidTracker::new(centres);
+    let timing = measure(
+        &mut w,
+        spec.steps,
+        |w| w.step(H),
+        |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn pendulum(solver: ContactSolver, spec: &Pendulum) -> Outcome {
+    let mut w = world(solver);
+    let bob = w
+        .add_body(BodyDef::new(rectangle(BOB, BOB), 1.0).at(at(Pendulum::bob_start()), 0.0))
+        .expect("valid bob");
+    let pin = w
+        .add_joint(JointDef::new(bob, None, Vec2::zeros()))
+        .expect("valid pin");
+    let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
+    let mut tracker = PeriodTracker::new(spec.h, centre(&w, bob).0, energy(&w));
+    let h = spec.h;
+    let timing = measure(
+        &mut w,
+        spec.steps(),
+        |w| w.step(h),
+        |w, n| {
+            let gap = w.joint_gap(pin).expect("joints are never removed");
+            tracker.update(n, centre(w, bob).0, energy(w), gap);
+        },
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn heavy_chain(solver: ContactSolver) -> Outcome {
+    let mut w = world(solver);
+    let link = rectangle(chain::LINK.0, chain::LINK.1);
+    let mut joints: Vec<JointHandle> = Vec::with_capacity(chain::LINKS + 1);
+    let mut previous: Option<BodyHandle> = None;
+    for i in 0..=chain::LINKS {
+        let def = if i < chain::LINKS {
+            BodyDef::new(link.clone(), chain::LINK_DENSITY).at(at(chain::link_centre(i)), 0.0)
+        } else {
+            let end = rectangle(chain::END_SIZE, chain::END_SIZE);
+            BodyDef::new(end, chain::END_DENSITY).at(at(chain::end_centre()), 0.0)
+        };
+        let body = w.add_body(def).expect("valid link");
+        // The first link is pinned to the world (body_b None), the others to the one before.
+        let pin = JointDef::new(body, previous, at(chain::pin(i)));
+        joints.push(w.add_joint(pin).expect("valid pin"));
+        previous = Some(body);
+    }
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(
+        &mut w,
+        chain::STEPS,
+        |w| w.step(H),
+        |w, _| {
+            for &j in &joints {
+                worst_gap = worst(worst_gap, w.joint_gap(j).expect("joints are never removed"));
+            }
+        },
+    );
+    Outcome::new(timing, Metric::Chain { worst_gap })
+}
+
+pub fn bounce(solver: ContactSolver) -> Outcome {
+    let mut w = world(solver);
+    floor(&mut w);
+    let half = 0.5 * bounce::SIZE;
+    let def = BodyDef::new(rectangle(bounce::SIZE, bounce::SIZE), 1.0)
+        .restitution(bounce::RESTITUTION)
+        .at(at((0.0, bounce::DROP + half)), 0.0);
+    let body = w.add_body(def).expect("valid box");
+    let mut tracker = ReboundTracker::default();
+    let timing = measure(
+        &mut w,
+        bounce::STEPS,
+        |w| w.step(H),
+        |w, _| {
+            let v_up = -w.body(body).expect("live").velocity.y;
+            tracker.update(centre(w, body).1 - half, v_up);
+        },
+    );
+    Outcome::new(timing, tracker.finish())
+}

@@ -1,0 +1,171 @@
+//! The scenes built in rapier2d. Rapier's y axis points up, as the scene's does, so points
+//! carry over unchanged and gravity is −10 m/s² along y. Rapier works in f32 (its default
+//! feature set); results are widened to f64 for the shared trackers.
+
+use crate::Outcome;
+use crate::harness::measure;
+use crate::scene::{
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
+    ReboundTracker, bounce, chain, worst,
+};
+use rapier2d::prelude::*;
+
+/// A scene point as rapier's vector type.
+fn point((x, y): (f64, f64)) -> Vector {
+    Vector::new(x as Real, y as Real)
+}
+
+fn centre(world: &PhysicsWorld, body: RigidBodyHandle) -> (f64, f64) {
+    let t = world.bodies[body].translation();
+    (f64::from(t.x), f64::from(t.y))
+}
+
+/// A world with the default integration parameters except the step.
+fn world(h: f64) -> PhysicsWorld {
+    let mut w = PhysicsWorld::new();
+    w.gravity = Vector::new(0.0, -G as Real);
+    w.integration_parameters.dt = h as Real;
+    w
+}
+
+/// A dynamic body at `position`. Sleeping is off so that every body is simulated on every
+/// step, as in pe, which has no sleeping: otherwise resting pyramids would cost nothing.
+fn dynamic(position: (f64, f64)) -> RigidBodyBuilder {
+    RigidBodyBuilder::dynamic()
+        .translation(point(position))
+        .can_sleep(false)
+}
+
+/// A box collider of full size `w` × `h` (rapier takes half-extents).
+fn cuboid(w: f64, h: f64, density: f64) -> ColliderBuilder {
+    ColliderBuilder::cuboid(0.5 * w as Real, 0.5 * h as Real).density(density as Real)
+}
+
+/// The static floor, top face at y = 0, with the scenes' friction so that rapier's default
+/// averaging of the pair's coefficients gives exactly `FRICTION`.
+fn floor(w: &mut PhysicsWorld, restitution: f64) {
+    let body = RigidBodyBuilder::fixed()
+        .translation(point((0.0, -0.5 * FLOOR.1)))
+        .can_sleep(false);
+    let shape = cuboid(FLOOR.0, FLOOR.1, 0.0)
+        .friction(FRICTION as Real)
+        .restitution(restitution as Real);
+    w.insert(body, shape);
+}
+
+pub fn pyramid(spec: &Pyramid) -> Outcome {
+    let mut w = world(H);
+    floor(&mut w, 0.0);
+    let centres = spec.centres();
+    let boxes: Vec<RigidBodyHandle> = centres
+        .iter()
+        .map(|&c| {
+            let shape = cuboid(BOX, BOX, 1.0).friction(FRICTION as Real);
+            w.insert(dynamic(c), shape).0
+        })
+        .collect();
+    let mut tracker = PyramidTracker::new(centres);
+    let timing = measure(&mut w, spec.steps, PhysicsWorld::step, |w, _| {
+        tracker.update(boxes.iter().map(|&b| centre(w, b)))
+    });
+    Outcome::new(timing, tracker.finish())
+}
+
+/// Kinetic plus gravitational energy of one body, computed here from its mass properties
+/// so that both engines' energies mean the same thing.
+fn energy(world: &PhysicsWorld, body: RigidBodyHandle) -> f64 {
+    let b = &world.bodies[body];
+    let mass = f64::from(b.mass());
+    let inertia = f64::from(b.mass_properties().local_mprops.principal_inertia());
+    let (v, omega) = (b.linvel(), f64::from(b.angvel()));
+    let kinetic = 0.5 * mass * f64::from(v.length_squared()) + 0.5 * inertia * omega * omega;
+    kinetic + mass * G * f64::from(b.center_of_mass().y)
+}
+
+pub fn pendulum(spec: &Pendulum) -> Outcome {
+    let mut w = world(spec.h);
+    // The pivot is a fixed body without collider at the origin.
+    let pivot = w.insert_body(RigidBodyBuilder::fixed());
+    let start = Pendulum::bob_start();
+    let (bob, _) = w.insert(dynamic(start), cuboid(BOB, BOB, 1.0));
+    // Mass properties are otherwise only updated inside the first step; E0 needs them now.
+    let PhysicsWorld {
+        bodies, colliders, ..
+    } = &mut w;
+    bodies[bob].recompute_mass_properties_from_colliders(colliders);
+    // Anchors in each body's frame: the pivot's origin, and the pivot as seen from the
+    // bob's centre.
+    let pin = RevoluteJointBuilder::new()
+        .local_anchor1(Vector::ZERO)
+        .local_anchor2(-point(start));
+    let pin = w.insert_impulse_joint(pivot, bob, pin);
+    let mut tracker = PeriodTracker::new(spec.h, centre(&w, bob).0, energy(&w, bob));
+    let timing = measure(&mut w, spec.steps(), PhysicsWorld::step, |w, n| {
+        tracker.update(n, centre(w, bob).0, energy(w, bob), joint_gap(w, pin))
+    });
+    Outcome::new(timing, tracker.finish())
+}
+
+/// Distance between a joint's two anchors in world coordinates.
+fn joint_gap(world: &PhysicsWorld, joint: ImpulseJointHandle) -> f64 {
+    let j = world
+        .impulse_joints
+        .get(joint)
+        .expect("joints are never removed");
+    let a = world.bodies[j.body1()]
+        .position()
+        .transform_point(j.data.local_anchor1());
+    let b = world.bodies[j.body2()]
+        .position()
+        .transform_point(j.data.local_anchor2());
+    f64::from(a.distance(b))
+}
+
+pub fn heavy_chain() -> Outcome {
+    let mut w = world(H);
+    let mut previous = (w.insert_body(RigidBodyBuilder::fixed()), (0.0, 0.0));
+    let mut joints = Vec::with_capacity(chain::LINKS + 1);
+    for i in 0..=chain::LINKS {
+        let (c, shape) = if i < chain::LINKS {
+            let shape = cuboid(chain::LINK.0, chain::LINK.1, chain::LINK_DENSITY);
+            (chain::link_centre(i), shape)
+        } else {
+            let shape = cuboid(chain::END_SIZE, chain::END_SIZE, chain::END_DENSITY);
+            (chain::end_centre(), shape)
+        };
+        let (body, _) = w.insert(dynamic(c), shape);
+        let pin = chain::pin(i);
+        // Each anchor is the pin relative to its body's centre. Pinned neighbours overlap
+        // at the pin, and pe never lets jointed bodies collide: switch contacts off.
+        let joint = RevoluteJointBuilder::new()
+            .local_anchor1(point(pin) - point(previous.1))
+            .local_anchor2(point(pin) - point(c))
+            .contacts_enabled(false);
+        joints.push(w.insert_impulse_joint(previous.0, body, joint));
+        previous = (body, c);
+    }
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(&mut w, chain::STEPS, PhysicsWorld::step, |w, _| {
+        for &j in &joints {
+            worst_gap = worst(worst_gap, joint_gap(w, j));
+        }
+    });
+    Outcome::new(timing, Metric::Chain { worst_gap })
+}
+
+pub fn bounce() -> Outcome {
+    let mut w = world(H);
+    // Rapier averages the pair's restitutions by default: with 0.5 on both the pair's is 0.5.
+    floor(&mut w, bounce::RESTITUTION);
+    let half = 0.5 * bounce::SIZE;
+    let shape = cuboid(bounce::SIZE, bounce::SIZE, 1.0)
+        .friction(FRICTION as Real)
+        .restitution(bounce::RESTITUTION as Real);
+    let (body, _) = w.insert(dynamic((0.0, bounce::DROP + half)), shape);
+    let mut tracker = ReboundTracker::default();
+    let timing = measure(&mut w, bounce::STEPS, PhysicsWorld::step, |w, _| {
+        let v_up = f64::from(w.bodies[body].linvel().y);
+        tracker.update(centre(w, body).1 - half, v_up);
+    });
+    Outcome::new(timing, tracker.finish())
+}

@@ -1,0 +1,414 @@
+//! The scenes, independent of any engine: sizes and placements in metres with y pointing
+//! UP (each engine module mirrors them into its own convention), their known answers, and
+//! the trackers that turn a run into the scene's metric. Keeping the trackers here means
+//! both engines are judged by the same code.
+
+use std::f64::consts::PI;
+use std::fmt;
+
+/// Gravity's magnitude, m/s².
+pub const G: f64 = 10.0;
+/// The default step, s.
+pub const H: f64 = 1.0 / 60.0;
+
+/// Friction coefficient of every contact in the pyramids (the floor's too, so that both
+/// engines' combination rules give 0.6).
+pub const FRICTION: f64 = 0.6;
+/// Side of a pyramid box, m.
+pub const BOX: f64 = 1.0;
+/// Size of the static floor, m; its top face is the line y = 0.
+pub const FLOOR: (f64, f64) = (100.0, 1.0);
+
+/// The larger of a running worst value and a new sample, where a NaN sample (an engine
+/// that blew up) counts as infinitely bad rather than being skipped as `f64::max` would.
+pub fn worst(so_far: f64, sample: f64) -> f64 {
+    if sample.is_nan() {
+        f64::INFINITY
+    } else {
+        so_far.max(sample)
+    }
+}
+
+/// A pyramid of unit boxes, `rows` at the base, standing on the floor.
+#[derive(Debug, Clone, Copy)]
+pub struct Pyramid {
+    pub name: &'static str,
+    pub rows: usize,
+    pub steps: usize,
+}
+
+pub const PYRAMIDS: [Pyramid; 2] = [
+    Pyramid {
+        name: "pyramid20",
+        rows: 20,
+        steps: 600,
+    },
+    // 820 boxes: 300 steps (5 s) keep the whole benchmark within a few minutes.
+    Pyramid {
+        name: "pyramid40",
+        rows: 40,
+        steps: 300,
+    },
+];
+
+impl Pyramid {
+    /// Box centres, bottom row first and the top box last. The boxes touch their
+    /// neighbours and the floor exactly, so nothing falls or overlaps at the start.
+    pub fn centres(&self) -> Vec<(f64, f64)> {
+        let mut centres = Vec::with_capacity(self.rows * (self.rows + 1) / 2);
+        for row in 0..self.rows {
+            let count = self.rows - row;
+            let left = -0.5 * (count - 1) as f64 * BOX;
+            for k in 0..count {
+                centres.push((left + k as f64 * BOX, (row as f64 + 0.5) * BOX));
+            }
+        }
+        centres
+    }
+}
+
+/// Follows every box of a pyramid: how far the top box slid sideways, and which boxes
+/// fell (their height changed by more than half a box at some point of the run).
+pub struct PyramidTracker {
+    start: Vec<(f64, f64)>,
+    fallen: Vec<bool>,
+    top_x: f64,
+}
+
+impl PyramidTracker {
+    pub fn new(start: Vec<(f64, f64)>) -> Self {
+        let top_x = start.last().map_or(0.0, |c| c.0);
+        Self {
+            fallen: vec![false; start.len()],
+            start,
+            top_x,
+        }
+    }
+
+    /// Centres now, y up, in the order given to `new`.
+    pub fn update(&mut self, centres: impl Iterator<Item = (f64, f64)>) {
+        for (i, (x, y)) in centres.enumerate() {
+            let moved = (y - self.start[i].1).abs();
+            // A NaN height (the engine blew up) counts as fallen.
+            self.fallen[i] |= moved.is_nan() || moved > 0.5 * BOX;
+            self.top_x = x;
+        }
+    }
+
+    pub fn finish(&self) -> Metric {
+        let top_start = self.start.last().map_or(0.0, |c| c.0);
+        Metric::Pyramid {
+            top_drift: (self.top_x - top_start).abs() / BOX,
+            fallen: self.fallen.iter().filter(|&&f| f).count(),
+            boxes: self.start.len(),
+        }
+    }
+}
+
+/// The 90° pendulum: a small square bob on a massless pin, where the exact period is known.
+#[derive(Debug, Clone, Copy)]
+pub struct Pendulum {
+    pub name: &'static str,
+    pub h: f64,
+}
+
+pub const PENDULUMS: [Pendulum; 2] = [
+    Pendulum {
+        name: "pendulum90 h=1/60",
+        h: 1.0 / 60.0,
+    },
+    Pendulum {
+        name: "pendulum90 h=1/240",
+        h: 1.0 / 240.0,
+    },
+];
+
+/// Distance from the pivot to the bob's centre, m.
+pub const PENDULUM_LENGTH: f64 = 1.0;
+/// Side of the square bob, m (density 1).
+pub const BOB: f64 = 0.05;
+/// Release angle from the vertical.
+pub const THETA0: f64 = PI / 2.0;
+/// Simulated time, s: about 25 periods, so the period is averaged over many swings.
+pub const PENDULUM_SECONDS: f64 = 60.0;
+
+impl Pendulum {
+    pub fn steps(&self) -> usize {
+        (PENDULUM_SECONDS / self.h).round() as usize
+    }
+
+    /// Where the bob's centre starts (y up), with the pivot at the origin: θ0 from the
+    /// downward vertical, towards +x.
+    pub fn bob_start() -> (f64, f64) {
+        (
+            PENDULUM_LENGTH * THETA0.sin(),
+            -PENDULUM_LENGTH * THETA0.cos(),
+        )
+    }
+
+    /// The compound pendulum's exact period, T = 4 √(I_p / (m g L)) K(sin(θ0/2)), with
+    /// I_p = m s²/6 + m L² the bob's moment of inertia about the pivot.
+    pub fn exact_period() -> f64 {
+        let m = BOB * BOB;
+        let l = PENDULUM_LENGTH;
+        let i_pivot = m * BOB * BOB / 6.0 + m * l * l;
+        4.0 * (i_pivot / (m * G * l)).sqrt() * elliptic_k((THETA0 / 2.0).sin())
+    }
+
+    /// The energy scale m g L that drifts are measured against.
+    pub fn energy_scale() -> f64 {
+        BOB * BOB * G * PENDULUM_LENGTH
+    }
+}
+
+/// Complete elliptic integral of the first kind K(k), by the arithmetic–geometric mean:
+/// K(k) = π / (2 AGM(1, √(1 − k²))). Thirty rounds are far more than converge in f64.
+pub fn elliptic_k(k: f64) -> f64 {
+    let (mut a, mut b) = (1.0f64, (1.0 - k * k).sqrt());
+    for _ in 0..30 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    PI / (2.0 * a)
+}
+
+/// Measures a pendulum's period from the times the bob crosses below the pivot moving
+/// towards +x (interpolated within the step), the largest energy excursion, and the widest
+/// the pin opened (a period means little if the pin let go).
+pub struct PeriodTracker {
+    h: f64,
+    prev_x: f64,
+    crossings: Vec<f64>,
+    e0: f64,
+    max_drift: f64,
+    worst_gap: f64,
+}
+
+impl PeriodTracker {
+    pub fn new(h: f64, x0: f64, e0: f64) -> Self {
+        Self {
+            h,
+            prev_x: x0,
+            crossings: Vec::new(),
+            e0,
+            max_drift: 0.0,
+            worst_gap: 0.0,
+        }
+    }
+
+    /// `steps` steps done; the bob's centre is at horizontal offset `x` from the pivot, the
+    /// total energy is `energy` and the pin's anchors are `gap` apart.
+    pub fn update(&mut self, steps: usize, x: f64, energy: f64, gap: f64) {
+        self.worst_gap = worst(self.worst_gap, gap);
+        if self.prev_x < 0.0 && x >= 0.0 {
+            let fraction = self.prev_x / (self.prev_x - x);
+            self.crossings
+                .push((steps as f64 - 1.0 + fraction) * self.h);
+        }
+        self.prev_x = x;
+        self.max_drift = worst(self.max_drift, (energy - self.e0).abs());
+    }
+
+    pub fn finish(&self) -> Metric {
+        let exact = Pendulum::exact_period();
+        let period_error = match self.crossings.as_slice() {
+            [first, .., last] => {
+                let period = (last - first) / (self.crossings.len() - 1) as f64;
+                (period - exact) / exact
+            }
+            _ => f64::NAN, // fewer than two crossings: it did not swing
+        };
+        Metric::Pendulum {
+            period_error,
+            energy_drift: self.max_drift / Pendulum::energy_scale(),
+            worst_gap: self.worst_gap,
+        }
+    }
+}
+
+/// The heavy chain: light links holding a body 500 times heavier than each.
+pub mod chain {
+    pub const NAME: &str = "heavychain";
+    pub const LINKS: usize = 10;
+    /// Link size, m: mass 0.2 kg at density 2.
+    pub const LINK: (f64, f64) = (1.0, 0.1);
+    pub const LINK_DENSITY: f64 = 2.0;
+    /// The end body: a 1 m square of 100 kg.
+    pub const END_SIZE: f64 = 1.0;
+    pub const END_DENSITY: f64 = 100.0;
+    pub const STEPS: usize = 600;
+
+    /// Pin `i` (0 = the one to the world) is at (i, 0): the chain lies level along +x,
+    /// so it is released horizontally and swings down.
+    pub fn pin(i: usize) -> (f64, f64) {
+        (i as f64 * LINK.0, 0.0)
+    }
+
+    pub fn link_centre(i: usize) -> (f64, f64) {
+        ((i as f64 + 0.5) * LINK.0, 0.0)
+    }
+
+    /// The end body hangs from the last pin by the middle of its left side.
+    pub fn end_centre() -> (f64, f64) {
+        (LINKS as f64 * LINK.0 + 0.5 * END_SIZE, 0.0)
+    }
+}
+
+/// The dropped box: restitution 0.5 from 2 m should rebound to e² · 2 m = 0.5 m.
+pub mod bounce {
+    pub const NAME: &str = "bounce";
+    pub const SIZE: f64 = 1.0;
+    pub const RESTITUTION: f64 = 0.5;
+    /// Height of the box's bottom above the floor at release, m.
+    pub const DROP: f64 = 2.0;
+    /// 2 s: the fall takes 0.63 s and the rebound rises for 0.32 s.
+    pub const STEPS: usize = 120;
+
+    pub fn expected_peak() -> f64 {
+        RESTITUTION * RESTITUTION * DROP
+    }
+}
+
+/// Finds the first rebound's peak: the highest the body's bottom gets between the first
+/// time it moves up and the first time after that it moves down again.
+#[derive(Default)]
+pub struct ReboundTracker {
+    rising: bool,
+    done: bool,
+    peak: Option<f64>,
+}
+
+impl ReboundTracker {
+    /// `bottom`: height of the body's bottom above the floor; `v_up`: its upward speed.
+    pub fn update(&mut self, bottom: f64, v_up: f64) {
+        if self.done {
+            return;
+        }
+        if v_up > 0.0 {
+            self.rising = true;
+        }
+        if self.rising {
+            self.peak = Some(self.peak.map_or(bottom, |p| p.max(bottom)));
+            if v_up <= 0.0 {
+                self.done = true;
+            }
+        }
+    }
+
+    pub fn finish(&self) -> Metric {
+        let expected = bounce::expected_peak();
+        let peak = self.peak.unwrap_or(f64::NAN);
+        Metric::Bounce {
+            peak,
+            error: (peak - expected) / expected,
+        }
+    }
+}
+
+/// A scene's error or stability figure.
+#[derive(Debug, Clone, Copy)]
+pub enum Metric {
+    Pyramid {
+        /// Top box's sideways displacement over the run, in box widths.
+        top_drift: f64,
+        fallen: usize,
+        boxes: usize,
+    },
+    Pendulum {
+        /// (measured − exact) / exact.
+        period_error: f64,
+        /// max |E − E0| / (m g L).
+        energy_drift: f64,
+        /// Widest anchor-to-anchor distance of the pin at any step, m.
+        worst_gap: f64,
+    },
+    Chain {
+        /// Widest anchor-to-anchor distance of any joint at any step, m.
+        worst_gap: f64,
+    },
+    Bounce {
+        /// Height of the first rebound's peak, m.
+        peak: f64,
+        /// (peak − expected) / expected.
+        error: f64,
+    },
+}
+
+impl fmt::Display for Metric {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Metric::Pyramid {
+                top_drift,
+                fallen,
+                boxes,
+            } => write!(
+                f,
+                "top drift {:.2}% of width; {fallen}/{boxes} fallen",
+                100.0 * top_drift
+            ),
+            Metric::Pendulum {
+                period_error,
+                energy_drift,
+                worst_gap,
+            } => write!(
+                f,
+                "period error {:+.3}%; energy drift {:.2}% of m g L; worst pin gap {worst_gap:.1e} m",
+                100.0 * period_error,
+                100.0 * energy_drift
+            ),
+            Metric::Chain { worst_gap } => write!(
+                f,
+                "worst gap {worst_gap:.2e} m = {:.2e} link lengths",
+                worst_gap / chain::LINK.0
+            ),
+            Metric::Bounce { peak, error } => {
+                write!(f, "peak {peak:.4} m, error {:+.2}%", 100.0 * error)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_nan_sample_is_the_worst() {
+        assert_eq!(worst(1.0, f64::NAN), f64::INFINITY);
+        assert_eq!(worst(1.0, 2.0), 2.0);
+    }
+
+    #[test]
+    fn elliptic_k_matches_known_values() {
+        assert!((elliptic_k(0.0) - PI / 2.0).abs() < 1e-15);
+        // K(sin 45°) = 1.854074677301372 (Abramowitz & Stegun table 17.1).
+        assert!((elliptic_k(0.5f64.sqrt()) - 1.854_074_677_301_372).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pyramid_has_triangular_count_with_the_top_box_last() {
+        let c = PYRAMIDS[0].centres();
+        assert_eq!(c.len(), 210);
+        assert_eq!(*c.last().unwrap(), (0.0, 19.5));
+        assert_eq!(c[0], (-9.5, 0.5));
+    }
+
+    #[test]
+    fn rebound_tracker_takes_the_first_peak_only() {
+        let mut t = ReboundTracker::default();
+        let samples = [
+            (2.0, 0.0),
+            (1.0, -3.0),
+            (0.0, 2.0),
+            (0.4, 1.0),
+            (0.5, -0.1),
+            (0.9, 5.0),
+        ];
+        for (y, v) in samples {
+            t.update(y, v);
+        }
+        let Metric::Bounce { peak, .. } = t.finish() else {
+            unreachable!()
+        };
+        assert_eq!(peak, 0.5);
+    }
+}
