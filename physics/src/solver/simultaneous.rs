@@ -47,6 +47,8 @@ pub struct SimultaneousSolver {
     scratch_contacts: Vec<Contact>,
     scratch_joints: Vec<JointConstraint>,
     pseudo: Vec<SolverBody>,
+    /// Velocities of an island's bodies during the row-by-row Gauss–Seidel.
+    sparse_bodies: Vec<SolverBody>,
     stage_one: Vec<f64>,
     island_contacts: Vec<(u32, Contact)>,
     island_joints: Vec<JointConstraint>,
@@ -260,6 +262,23 @@ impl SimultaneousSolver {
     /// Solves the current rows and, if `apply`, applies their impulses.
     fn solve_rows(&mut self, bodies: &mut [SolverBody], apply: bool) {
         let n = self.rows.len();
+        if n > self.dense_row_limit {
+            let sweeps = self.solve_rows_sparse(bodies);
+            if apply {
+                for (row, &x) in self.rows.iter().zip(&self.x) {
+                    row.apply(bodies, x);
+                }
+                self.reports.push(IslandReport {
+                    contacts: self.island_contacts.len(),
+                    joints: self.island_joints.len(),
+                    rows: n,
+                    pivoting: false,
+                    pivots: sweeps,
+                    residual: f64::NAN,
+                });
+            }
+            return;
+        }
         assemble(&self.rows, bodies, &mut self.a);
         self.b.clear();
         self.lo.clear();
@@ -298,6 +317,74 @@ impl SimultaneousSolver {
                 residual: stats.residual,
             });
         }
+    }
+
+    /// Projected Gauss–Seidel on the rows themselves, for islands too big for a dense
+    /// matrix: each row's velocity is read from the bodies as the impulses accumulate, so
+    /// a sweep costs O(rows), not O(rows²). Leaves the impulses in `x` (the bodies are not
+    /// changed) and returns the sweeps made.
+    fn solve_rows_sparse(&mut self, bodies: &[SolverBody]) -> usize {
+        const SWEEPS: usize = 200;
+        let n = self.rows.len();
+        self.x.clear();
+        self.x.resize(n, 0.0);
+        // Scratch velocities of the island's bodies only.
+        let scratch = &mut self.sparse_bodies;
+        scratch.resize(bodies.len(), SolverBody::default());
+        for row in &self.rows {
+            for e in &row.ends {
+                scratch[e.body as usize] = bodies[e.body as usize];
+            }
+        }
+        // w_i = (row velocity now) + offset_i, where offset_i = b_i − (velocity at start).
+        self.b.clear();
+        self.lo.clear();
+        for row in &self.rows {
+            let start = row.velocity(bodies);
+            self.b.push(row.b - start);
+            let diagonal: f64 = row
+                .ends
+                .iter()
+                .map(|e| {
+                    let t = &bodies[e.body as usize];
+                    t.inv_mass * e.linear.norm_squared() + t.inv_inertia * e.angular * e.angular
+                })
+                .sum();
+            self.lo.push(diagonal); // reused as the diagonal
+        }
+        let mut sweeps = 0;
+        while sweeps < SWEEPS {
+            sweeps += 1;
+            let mut change: f64 = 0.0;
+            let mut size: f64 = 0.0;
+            for i in 0..n {
+                let row = &self.rows[i];
+                let diagonal = self.lo[i];
+                if diagonal <= 0.0 {
+                    continue;
+                }
+                let (lo, hi) = match row.friction_of {
+                    Some((j, mu)) => {
+                        let bound = mu * self.x[j].max(0.0);
+                        (-bound, bound)
+                    }
+                    None => (row.lo, row.hi),
+                };
+                let w = row.velocity(scratch) + self.b[i];
+                let new = (self.x[i] - w / diagonal).clamp(lo, hi);
+                let delta = new - self.x[i];
+                if delta != 0.0 {
+                    row.apply(scratch, delta);
+                    self.x[i] = new;
+                }
+                change = change.max((delta * diagonal.sqrt()).abs());
+                size = size.max((new * diagonal.sqrt()).abs());
+            }
+            if change <= 1e-10 * size.max(1e-300) {
+                break;
+            }
+        }
+        sweeps
     }
 
     /// Records the impulses in the contacts and joints they belong to.

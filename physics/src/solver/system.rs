@@ -39,7 +39,7 @@ pub struct Row {
 }
 
 impl Row {
-    fn velocity(&self, bodies: &[SolverBody]) -> f64 {
+    pub fn velocity(&self, bodies: &[SolverBody]) -> f64 {
         self.ends
             .iter()
             .map(|e| {
