@@ -570,7 +570,7 @@ impl RoboSimApp {
                     }
                 })
                 .response
-                .on_hover_text("The contact solver: exact (coupled LCP), thesis (two-stage LCP), soft (iterative), sequential");
+                .on_hover_text("The contact solver: exact (coupled LCP, the default), thesis (two-stage LCP as in the thesis), soft (iterative, fast on piles; experimental: its pin joints do not hold yet), sequential (one contact at a time)");
             if self.solver != before
                 && let Some(sim) = &mut self.sim
             {
