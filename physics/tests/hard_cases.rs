@@ -172,7 +172,7 @@ fn a_huge_torque_spins_a_body_without_breaking_the_world() {
 
 /// A random convex body: a regular polygon of 3–8 sides, radius 0.2–1.5, anywhere in a
 /// 16 × 10 box above the floor, with a random velocity and spin.
-fn random_body() -> impl Strategy<Value = (usize, f64, f64, f64, f64, f64, f64, f64, f64)> {
+fn random_body() -> impl Strategy<Value = RandomBody> {
     (
         3usize..=8,
         0.2..1.5f64,
@@ -186,6 +186,252 @@ fn random_body() -> impl Strategy<Value = (usize, f64, f64, f64, f64, f64, f64, 
     )
 }
 
+type RandomBody = (usize, f64, f64, f64, f64, f64, f64, f64, f64);
+
+/// What a random world did in 1,000 steps.
+struct Thrown {
+    /// The first step with a non-finite state, if any.
+    non_finite_at: Option<usize>,
+    /// The largest rise of total energy above its start, over Σ m g × box height.
+    energy_rise: f64,
+    /// The deepest penetration after the first 2 s, over the smallest body's radius.
+    depth: f64,
+}
+
+/// Random convex bodies thrown together in a walled 20 × 20 box for 1,000 steps.
+fn throw_together(bodies: &[RandomBody], solver: ContactSolver) -> Thrown {
+    let g = 10.0;
+    let mut w = World::new(Vec2::new(0.0, g));
+    w.settings.contact_solver = solver;
+    w.friction = 0.5;
+    // Floor and walls, each 1 thick, around [-10, 10] × [-20, 0].
+    for (size, at) in [
+        (Vec2::new(22.0, 1.0), Vec2::new(0.0, 0.5)),
+        (Vec2::new(1.0, 22.0), Vec2::new(-10.5, -10.0)),
+        (Vec2::new(1.0, 22.0), Vec2::new(10.5, -10.0)),
+    ] {
+        let shape = ConvexPolygon::rectangle(size.x, size.y).unwrap();
+        w.add_body(BodyDef::new(shape, 0.0).restitution(1.0).at(at, 0.0))
+            .unwrap();
+    }
+    let mut smallest = f64::INFINITY;
+    let mut weight = 0.0;
+    for (i, &(sides, radius, x, y, angle, vx, vy, spin, e)) in bodies.iter().enumerate() {
+        let shape = ConvexPolygon::regular(sides, radius).unwrap();
+        let def = BodyDef::new(shape, 1.0)
+            .restitution(e)
+            .at(Vec2::new(x, y - 0.01 * i as f64), angle)
+            .velocity(Vec2::new(vx, vy), spin);
+        let handle = w.add_body(def).unwrap();
+        weight += w.body(handle).unwrap().mass() * g;
+        smallest = smallest.min(radius);
+    }
+    w.settings.length_scale = smallest;
+    let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
+    let e0 = energy(&w);
+    let mut thrown = Thrown {
+        non_finite_at: None,
+        energy_rise: 0.0,
+        depth: 0.0,
+    };
+    for step in 0..1000 {
+        w.step(H);
+        if !finite(&w) {
+            thrown.non_finite_at = Some(step);
+            break;
+        }
+        thrown.energy_rise = thrown.energy_rise.max((energy(&w) - e0) / (weight * 20.0));
+        // Random starts may overlap; judge depth once the world had time to separate.
+        if step >= 120 {
+            let deepest = w.contacts().iter().map(|c| c.depth).fold(0.0, f64::max);
+            thrown.depth = thrown.depth.max(deepest / smallest);
+        }
+    }
+    thrown
+}
+
+/// Found by an unseeded run of the property below: fifteen polygons under `exact` once
+/// penetrated 0.27 of the smallest radius.
+const FOUND_DEEP: [RandomBody; 15] = [
+    (
+        7,
+        1.4475026259104642,
+        -5.087691999722248,
+        -3.4830643085570347,
+        4.412955451600455,
+        3.709934880866184,
+        1.4348069956604095,
+        -2.047625673856624,
+        0.3,
+    ),
+    (
+        8,
+        1.1574923890469182,
+        5.723816496968454,
+        -6.032991827328465,
+        2.2959985449443225,
+        -0.25763160323302314,
+        1.0072620767504947,
+        -0.5271744285252923,
+        0.0,
+    ),
+    (
+        6,
+        0.3231108879323797,
+        -2.843692030768882,
+        -9.445152928994403,
+        3.302029139063035,
+        4.247623092654904,
+        0.7523125773181605,
+        2.793567003755328,
+        0.3,
+    ),
+    (
+        7,
+        0.29699901124039907,
+        0.5301649727296288,
+        -9.986481968095164,
+        6.255634177319115,
+        -2.641415771378649,
+        4.410637096812589,
+        0.05133735702540995,
+        0.3,
+    ),
+    (
+        4,
+        1.3286126972625272,
+        -7.919994254830915,
+        -1.6399562040315219,
+        3.609171236734341,
+        -0.937425267632071,
+        1.1303939774867962,
+        -1.3808365088620669,
+        0.8,
+    ),
+    (
+        7,
+        0.3675844783206639,
+        0.7585465534273803,
+        -8.221057123459818,
+        0.015739721556914534,
+        0.3900861113719839,
+        2.5023298183682754,
+        0.49832235948399173,
+        0.0,
+    ),
+    (
+        5,
+        1.2195654465747006,
+        -6.190535971337486,
+        -2.4440258632023792,
+        5.853607593167681,
+        0.825542425039927,
+        3.9088388409196426,
+        -0.8676198000527174,
+        0.8,
+    ),
+    (
+        8,
+        1.1465250869516768,
+        -5.0783098596239915,
+        -8.472462543891401,
+        3.788002444854835,
+        -3.4101052273935624,
+        -0.92130642890851,
+        -0.9805856460225194,
+        0.8,
+    ),
+    (
+        8,
+        0.303120737894728,
+        -3.961241913881764,
+        -9.843355285083963,
+        5.261487320828815,
+        2.0638727707363436,
+        0.2976047457264132,
+        -2.9817947634122053,
+        0.8,
+    ),
+    (
+        5,
+        1.388733226157481,
+        7.324634265288341,
+        -6.927886626276453,
+        3.0658514656633296,
+        -0.8081311009373952,
+        -0.28193455604748563,
+        -2.722479416495934,
+        0.3,
+    ),
+    (
+        6,
+        0.8626215623134985,
+        2.2273598964116155,
+        -2.723066690107648,
+        2.098734038627296,
+        -0.36171239205306727,
+        4.654840627846166,
+        -0.761698176071192,
+        0.8,
+    ),
+    (
+        3,
+        0.7137901633656565,
+        4.623688607749771,
+        -11.202490011622912,
+        1.3649232348650935,
+        -2.6872821584005315,
+        -2.282308320008131,
+        1.8125476666759242,
+        0.3,
+    ),
+    (
+        7,
+        0.4685283571379526,
+        -2.5065355015588158,
+        -8.764516040429902,
+        1.2189538037028589,
+        -2.5774270902285332,
+        -1.0832081277677088,
+        0.2137230087428427,
+        0.3,
+    ),
+    (
+        3,
+        0.7878446338021808,
+        0.29787996817989926,
+        -1.404791381085641,
+        3.9639136413766702,
+        4.573969809145234,
+        2.144447289545383,
+        -0.8459009638068048,
+        0.8,
+    ),
+    (
+        8,
+        0.36635148281242513,
+        0.5895094039268559,
+        -9.7376058064555,
+        5.337630185905799,
+        1.4153401747945569,
+        -1.5778448524942454,
+        1.5069848697836767,
+        0.8,
+    ),
+];
+
+#[test]
+#[ignore = "known failure, open in issue 9: exact lets this pile penetrate 0.27 of a radius"]
+fn a_pile_found_by_the_property_test_stays_shallow() {
+    let thrown = throw_together(&FOUND_DEEP, ContactSolver::Exact);
+    assert_eq!(thrown.non_finite_at, None);
+    assert!(
+        thrown.depth < 0.2,
+        "penetration {} of the smallest radius",
+        thrown.depth
+    );
+}
+
 proptest! {
     // A fixed seed: the same twelve worlds on every run, so that CI is deterministic;
     // shrinking is capped because each case steps a world 1,000 times.
@@ -197,56 +443,16 @@ proptest! {
         ..ProptestConfig::default()
     })]
 
-    /// Random convex bodies thrown together in a walled box for 1,000 steps: no NaN, the
-    /// total energy never rises above its start by more than 1% of the energy scale
-    /// (Σ m g × box height; no motors), and no contact penetrates deeper than a fifth of
-    /// the smallest body.
+    /// No NaN; the total energy never rises above its start by 1% of Σ m g × box height
+    /// (no motors); no contact deeper than a fifth of the smallest body.
     #[test]
     fn random_worlds_stay_finite_bounded_and_shallow(
         bodies in prop::collection::vec(random_body(), 2..24),
         solver in prop_oneof![Just(ContactSolver::Exact), Just(ContactSolver::Thesis), Just(ContactSolver::Soft)],
     ) {
-        let g = 10.0;
-        let mut w = World::new(Vec2::new(0.0, g));
-        w.settings.contact_solver = solver;
-        w.friction = 0.5;
-        // Floor and walls, each 1 thick, around the 20 × 20 box [-10, 10] × [-20, 0].
-        for (size, at) in [
-            (Vec2::new(22.0, 1.0), Vec2::new(0.0, 0.5)),
-            (Vec2::new(1.0, 22.0), Vec2::new(-10.5, -10.0)),
-            (Vec2::new(1.0, 22.0), Vec2::new(10.5, -10.0)),
-        ] {
-            let shape = ConvexPolygon::rectangle(size.x, size.y).unwrap();
-            w.add_body(BodyDef::new(shape, 0.0).restitution(1.0).at(at, 0.0)).unwrap();
-        }
-        let mut smallest = f64::INFINITY;
-        let mut weight = 0.0;
-        for (i, &(sides, radius, x, y, angle, vx, vy, spin, e)) in bodies.iter().enumerate() {
-            let shape = ConvexPolygon::regular(sides, radius).unwrap();
-            let def = BodyDef::new(shape, 1.0)
-                .restitution(e)
-                .at(Vec2::new(x, y - 0.01 * i as f64), angle)
-                .velocity(Vec2::new(vx, vy), spin);
-            let handle = w.add_body(def).unwrap();
-            let b = w.body(handle).unwrap();
-            weight += b.mass() * g;
-            smallest = smallest.min(radius);
-        }
-        w.settings.length_scale = smallest;
-        let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
-        let e0 = energy(&w);
-        let scale = weight * 20.0;
-        let mut deepest: f64 = 0.0;
-        for step in 0..1000 {
-            w.step(H);
-            prop_assert!(finite(&w), "not finite at step {}", step);
-            let rise = energy(&w) - e0;
-            prop_assert!(rise < 0.01 * scale, "energy rose by {} of {} at step {}", rise, scale, step);
-            // Random starts may overlap; judge depth once the world had time to separate.
-            if step >= 120 {
-                deepest = w.contacts().iter().map(|c| c.depth).fold(deepest, f64::max);
-            }
-        }
-        prop_assert!(deepest < 0.2 * smallest, "{:?}: penetration {} with bodies of radius {}", solver, deepest, smallest);
+        let thrown = throw_together(&bodies, solver);
+        prop_assert_eq!(thrown.non_finite_at, None);
+        prop_assert!(thrown.energy_rise < 0.01, "{:?}: energy rose by {}", solver, thrown.energy_rise);
+        prop_assert!(thrown.depth < 0.2, "{:?}: penetration {} of the smallest radius", solver, thrown.depth);
     }
 }
