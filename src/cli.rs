@@ -59,6 +59,10 @@ pub struct RunArgs {
     /// The contact solver: exact, thesis, soft or sequential (default: the scene's, else exact).
     #[arg(long, value_parser = parse_solver)]
     pub solver: Option<ContactSolver>,
+    /// Let bodies at rest sleep (skipped until something wakes them): faster, and the
+    /// trace shows them exactly still.
+    #[arg(long)]
+    pub sleep: bool,
     /// Write a record every K steps (and at step 0 and the last step).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     pub every: u64,
@@ -173,6 +177,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     }
     let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
         .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
+    sim.world.settings.sleeping = args.sleep;
     let format = args.format.unwrap_or(match &args.out {
         Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) => Format::Csv,
         _ => Format::Jsonl,

@@ -213,3 +213,42 @@ fn check_passes_the_default_database_and_fails_a_broken_one() {
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert!(stdout.contains("scenes.xml:3:5: error: <robot> in scene \"lost\": source \"no such robot\" is not a robot"), "{stdout}");
 }
+
+#[test]
+fn sleep_lets_the_stack_of_boxes_come_exactly_to_rest() {
+    // The stack settles and the ball rolls to a stop; with --sleep the last records show
+    // every body exactly still, and its pose the same in both.
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "1200",
+        "--every",
+        "600",
+        "--sleep",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let records: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let (middle, last) = (&records[1], &records[2]);
+    for (a, b) in middle["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(last["bodies"].as_array().unwrap())
+    {
+        for key in ["vx", "vy", "omega"] {
+            assert_eq!(b[key].as_f64(), Some(0.0), "{} {key}", b["id"]);
+        }
+        for key in ["x", "y", "angle"] {
+            assert_eq!(a[key], b[key], "{} {key}", b["id"]);
+        }
+    }
+}

@@ -105,6 +105,12 @@ pub struct Body {
     /// Force and torque accumulated since the last step, cleared by it.
     pub force: Vec2,
     pub torque: f64,
+    /// Asleep: at rest with its island, skipped by the step until something wakes it.
+    /// An asleep body's inverse mass and inertia are held at 0 so that every stage treats
+    /// it as fixed.
+    pub(crate) asleep: bool,
+    /// How long the body has been slower than the sleep tolerance (s).
+    pub(crate) still_time: f64,
 }
 
 impl Body {
@@ -156,11 +162,34 @@ impl Body {
             angular_velocity: def.angular_velocity,
             force: Vec2::zeros(),
             torque: 0.0,
+            asleep: false,
+            still_time: 0.0,
         })
     }
 
+    /// Density 0: never moves.
     pub fn is_static(&self) -> bool {
+        self.mass == 0.0
+    }
+    /// Static, or asleep: the step does not move it.
+    pub(crate) fn is_fixed(&self) -> bool {
         self.inv_mass == 0.0
+    }
+    pub fn is_asleep(&self) -> bool {
+        self.asleep
+    }
+    pub(crate) fn fall_asleep(&mut self) {
+        self.asleep = true;
+        self.velocity = Vec2::zeros();
+        self.angular_velocity = 0.0;
+        self.inv_mass = 0.0;
+        self.inv_inertia = 0.0;
+    }
+    pub(crate) fn wake(&mut self) {
+        self.asleep = false;
+        self.still_time = 0.0;
+        self.inv_mass = self.inv_mass();
+        self.inv_inertia = self.inv_inertia();
     }
     pub fn area(&self) -> f64 {
         self.area
@@ -176,11 +205,20 @@ impl Body {
     pub fn inertia(&self) -> f64 {
         self.inertia
     }
+    /// 1 / mass; 0 for a static body (also while asleep: the value is the body's own).
     pub fn inv_mass(&self) -> f64 {
-        self.inv_mass
+        if self.mass > 0.0 {
+            1.0 / self.mass
+        } else {
+            0.0
+        }
     }
     pub fn inv_inertia(&self) -> f64 {
-        self.inv_inertia
+        if self.inertia > 0.0 {
+            1.0 / self.inertia
+        } else {
+            0.0
+        }
     }
     /// Distance from the centroid to the farthest vertex.
     pub fn bounding_radius(&self) -> f64 {

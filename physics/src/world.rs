@@ -4,6 +4,7 @@ use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
+use crate::solver::island::UnionFind;
 use crate::solver::joint::{
     Joint, JointBlockSolver, JointConstraint, JointHandle, JointIterations, JointMotor,
     JointSolver, velocity_gap_target,
@@ -35,6 +36,8 @@ pub struct StepSettings {
     pub joint_solver: JointSolver,
     /// Islands with more LCP rows than this are solved iteratively rather than by pivoting.
     pub dense_row_limit: usize,
+    /// Whether islands at rest go to sleep (see `World::step`).
+    pub sleeping: bool,
 }
 
 impl Default for StepSettings {
@@ -45,6 +48,7 @@ impl Default for StepSettings {
             length_scale: 1.0,
             joint_solver: JointSolver::default(),
             dense_row_limit: crate::solver::simultaneous::DENSE_ROW_LIMIT,
+            sleeping: false,
         }
     }
 }
@@ -53,6 +57,11 @@ impl StepSettings {
     /// Bodies closer than this count as touching, so resting contacts persist (SPEC §3.1).
     pub fn contact_margin(&self) -> f64 {
         0.02 * self.length_scale
+    }
+
+    /// A body slower than this (at its farthest point) counts as still, for sleeping.
+    pub fn sleep_speed(&self) -> f64 {
+        0.05 * self.length_scale
     }
 
     /// Penetration up to this depth is left alone, so resting contacts stay in touch.
@@ -139,12 +148,19 @@ pub struct World {
     body_motors: Vec<(BodyHandle, BodyMotor)>,
     manifolds: Vec<Manifold>,
     contacts: Vec<Contact>,
+    /// Per body: the island it fell asleep with (woken together).
+    sleep_labels: Vec<u32>,
     scratch: Scratch,
 }
+
+/// Seconds an island must stay still before it sleeps.
+const SLEEP_AFTER: f64 = 0.5;
 
 /// Buffers reused from step to step so that stepping does not allocate.
 #[derive(Debug, Clone, Default)]
 struct Scratch {
+    sleep_union: UnionFind,
+    wake_labels: Vec<u32>,
     polygons: Vec<WorldPolygon>,
     boxes: Vec<Option<Aabb>>,
     broad_phase: SweepAndPrune,
@@ -351,11 +367,172 @@ impl World {
     }
 
     /// Advances the world by `dt`: SPEC §3.4's stages, in order.
+    ///
+    /// With `settings.sleeping`, an island (bodies linked by contacts and joints) whose
+    /// bodies have all been slower than `sleep_speed` for `SLEEP_AFTER` seconds, with no
+    /// motor running, goes to sleep: it is skipped until an awake body comes within reach
+    /// of one of its bodies, a motor on it switches on, or `wake_body` is called.
     pub fn step(&mut self, dt: f64) {
+        if self.settings.sleeping {
+            self.wake_where_needed(dt);
+        }
         if self.settings.contact_solver == ContactSolver::Soft {
             self.step_soft(dt);
+        } else {
+            self.step_impulses(dt);
+        }
+        if self.settings.sleeping {
+            self.sleep_where_still(dt);
+        } else if self.bodies.iter().flatten().any(|b| b.asleep) {
+            self.bodies.iter_mut().flatten().for_each(Body::wake);
+        }
+    }
+
+    /// Wakes `handle` and everything asleep in its island.
+    pub fn wake_body(&mut self, handle: BodyHandle) {
+        let Some(label) = self.sleep_labels.get(handle.index()).copied() else {
+            return;
+        };
+        if self.body(handle).is_some_and(|b| b.asleep) {
+            self.wake_island(label);
+        }
+    }
+
+    fn wake_island(&mut self, label: u32) {
+        for (body, &l) in self.bodies.iter_mut().zip(&self.sleep_labels) {
+            if let Some(b) = body
+                && b.asleep
+                && l == label
+            {
+                b.wake();
+            }
+        }
+    }
+
+    /// Wakes sleeping islands that an awake body can reach this step, and those with a
+    /// motor switching on.
+    fn wake_where_needed(&mut self, dt: f64) {
+        let margin = self.settings.contact_margin();
+        let mut wake = std::mem::take(&mut self.scratch.wake_labels);
+        wake.clear();
+        let asleep: Vec<usize> = (0..self.bodies.len())
+            .filter(|&i| self.bodies[i].as_ref().is_some_and(|b| b.asleep))
+            .collect();
+        if asleep.is_empty() {
+            self.scratch.wake_labels = wake;
             return;
         }
+        for awake in self.bodies.iter().flatten().filter(|b| !b.is_fixed()) {
+            let reach = (awake.velocity.norm()
+                + awake.angular_velocity.abs() * awake.bounding_radius()
+                + self.gravity.norm() * dt)
+                * dt;
+            for &i in &asleep {
+                let b = self.bodies[i].as_ref().expect("listed as asleep");
+                let apart = (b.position - awake.position).norm()
+                    - b.bounding_radius()
+                    - awake.bounding_radius();
+                if apart <= margin + reach {
+                    wake.push(self.sleep_labels[i]);
+                }
+            }
+        }
+        let step = self.step_count;
+        for (h, m) in &self.body_motors {
+            if m.is_on(step) && self.body(*h).is_some_and(|b| b.asleep) {
+                wake.push(self.sleep_labels[h.index()]);
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if j.motor.is_some_and(|m| m.enabled) {
+                for h in [Some(j.body_a), j.body_b].into_iter().flatten() {
+                    if self.body(h).is_some_and(|b| b.asleep) {
+                        wake.push(self.sleep_labels[h.index()]);
+                    }
+                }
+            }
+        }
+        wake.sort_unstable();
+        wake.dedup();
+        for &label in &wake {
+            self.wake_island(label);
+        }
+        self.scratch.wake_labels = wake;
+    }
+
+    /// Times how long each awake body has been still, and puts to sleep the islands whose
+    /// bodies have all been still long enough.
+    fn sleep_where_still(&mut self, dt: f64) {
+        let tolerance = self.settings.sleep_speed();
+        for b in self.bodies.iter_mut().flatten() {
+            if b.is_fixed() {
+                continue;
+            }
+            let speed = b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius();
+            b.still_time = if speed < tolerance {
+                b.still_time + dt
+            } else {
+                0.0
+            };
+        }
+        let n = self.bodies.len();
+        let moving = |bodies: &[Option<Body>], i: u32| {
+            bodies[i as usize].as_ref().is_some_and(|b| !b.is_fixed())
+        };
+        let uf = &mut self.scratch.sleep_union;
+        uf.reset(n);
+        for c in &self.contacts {
+            if moving(&self.bodies, c.body_a) && moving(&self.bodies, c.body_b) {
+                uf.union(c.body_a, c.body_b);
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if let Some(b) = j.body_b
+                && moving(&self.bodies, j.body_a.0)
+                && moving(&self.bodies, b.0)
+            {
+                uf.union(j.body_a.0, b.0);
+            }
+        }
+        // An island may sleep when its stillest-to-be body has waited long enough and no
+        // motor in it runs.
+        let mut ready = vec![true; n];
+        for i in 0..n as u32 {
+            if let Some(b) = self.bodies[i as usize].as_ref()
+                && !b.is_fixed()
+                && b.still_time < SLEEP_AFTER
+            {
+                ready[uf.find(i) as usize] = false;
+            }
+        }
+        let step = self.step_count;
+        for (h, m) in &self.body_motors {
+            if m.is_on(step) {
+                ready[uf.find(h.0) as usize] = false;
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if j.motor.is_some_and(|m| m.enabled) {
+                ready[uf.find(j.body_a.0) as usize] = false;
+                if let Some(b) = j.body_b {
+                    ready[uf.find(b.0) as usize] = false;
+                }
+            }
+        }
+        self.sleep_labels.resize(n, u32::MAX);
+        for i in 0..n as u32 {
+            let root = uf.find(i);
+            if let Some(b) = self.bodies[i as usize].as_mut()
+                && !b.is_fixed()
+                && ready[root as usize]
+            {
+                b.fall_asleep();
+                self.sleep_labels[i as usize] = root;
+            }
+        }
+    }
+
+    fn step_impulses(&mut self, dt: f64) {
         self.apply_motor_torques(dt);
         self.repair_broken_joints(dt);
         let mut substeps = self.substeps_for(dt);
@@ -467,8 +644,8 @@ impl World {
             if gap == 0.0 {
                 continue;
             }
-            let is_static = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_static);
-            let (moving, direction) = match (is_static(c.body_a), is_static(c.body_b)) {
+            let is_fixed = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_fixed);
+            let (moving, direction) = match (is_fixed(c.body_a), is_fixed(c.body_b)) {
                 (false, true) => (c.body_a, -c.normal),
                 (true, false) => (c.body_b, c.normal),
                 _ => continue,
@@ -493,7 +670,7 @@ impl World {
         let s = &mut self.scratch;
         s.accelerations.clear();
         s.accelerations.extend(self.bodies.iter().map(|b| match b {
-            Some(b) if !b.is_static() => (
+            Some(b) if !b.is_fixed() => (
                 self.gravity + b.force * b.inv_mass,
                 b.torque * b.inv_inertia,
             ),
@@ -620,7 +797,7 @@ impl World {
                     .map_or((Vec2::zeros(), 0.0), |b| (b.velocity, b.angular_velocity))
             }));
         for b in self.bodies.iter_mut().flatten() {
-            if b.is_static() {
+            if b.is_fixed() {
                 continue;
             }
             b.velocity += (self.gravity + b.force * b.inv_mass) * dt;
@@ -650,10 +827,11 @@ impl World {
             }));
         }
         let bodies = &self.bodies;
-        let is_static = |i: usize| bodies[i].as_ref().is_none_or(Body::is_static);
+        // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
+        let is_fixed = |i: usize| bodies[i].as_ref().is_none_or(Body::is_fixed);
         let non_colliding = &self.non_colliding;
         let wanted = |i: usize, j: usize| {
-            !(is_static(i) && is_static(j))
+            !(is_fixed(i) && is_fixed(j))
                 && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
         };
         s.broad_phase.pairs(&s.boxes, wanted, &mut s.pairs);
@@ -720,8 +898,8 @@ impl World {
                 continue;
             }
             let (ia, ib) = (m.body_a.index(), m.body_b.index());
-            let inv_a = self.bodies[ia].as_ref().map_or(0.0, Body::inv_mass);
-            let inv_b = self.bodies[ib].as_ref().map_or(0.0, Body::inv_mass);
+            let inv_a = self.bodies[ia].as_ref().map_or(0.0, |b| b.inv_mass);
+            let inv_b = self.bodies[ib].as_ref().map_or(0.0, |b| b.inv_mass);
             let total = inv_a + inv_b;
             if total == 0.0 {
                 continue;
@@ -804,7 +982,7 @@ impl World {
         let gravity = self.gravity;
         let explicit = self.settings.integrator == Integrator::ExplicitEuler;
         for b in self.bodies.iter_mut().flatten() {
-            if b.is_static() {
+            if b.is_fixed() {
                 continue;
             }
             let (v, w) = if explicit {

@@ -15,6 +15,8 @@ pub struct DebugDraw {
     pub centres: bool,
     pub velocities: bool,
     pub grid: bool,
+    /// Sleeping bodies drawn faded, with a "z".
+    pub sleeping: bool,
     /// The view follows the selected body, or the moving bodies' mean position.
     pub follow: bool,
 }
@@ -28,6 +30,7 @@ impl Default for DebugDraw {
             centres: false,
             velocities: false,
             grid: true,
+            sleeping: true,
             follow: true,
         }
     }
@@ -48,6 +51,7 @@ impl Grab {
     const DAMPING: f64 = 0.9;
 
     pub fn apply(&self, sim: &mut Simulation) {
+        sim.world.wake_body(self.body);
         let Some(body) = sim.world.body_mut(self.body) else {
             return;
         };
@@ -228,11 +232,21 @@ pub fn show(
         } else {
             Stroke::new(1.0, Color32::from_gray(230))
         };
+        let asleep = debug.sleeping && body.is_asleep();
         painter.add(Shape::convex_polygon(
             points,
-            fill.gamma_multiply(0.85),
+            fill.gamma_multiply(if asleep { 0.4 } else { 0.85 }),
             stroke,
         ));
+        if asleep {
+            painter.text(
+                to_screen(body.position),
+                egui::Align2::CENTER_CENTER,
+                "z",
+                egui::FontId::proportional(12.0),
+                Color32::from_gray(200),
+            );
+        }
         if debug.centres {
             painter.circle_filled(to_screen(body.centroid()), 3.0, Color32::BLACK);
             painter.circle_stroke(

@@ -61,6 +61,8 @@ pub struct RoboSimApp {
     /// The selected scene running (or a robot or body previewed as a scene of its own).
     pub sim: Option<Simulation>,
     pub solver: ContactSolver,
+    /// Whether bodies at rest sleep in the simulations the app runs.
+    pub sleeping: bool,
     pub camera: Camera,
     camera_fitted: bool,
     pub running: bool,
@@ -128,6 +130,7 @@ impl RoboSimApp {
             selection: None,
             sim: None,
             solver: ContactSolver::default(),
+            sleeping: true,
             camera: Camera::default(),
             camera_fitted: false,
             running: true,
@@ -180,7 +183,8 @@ impl RoboSimApp {
         .unwrap_or(self.solver);
         self.solver = solver;
         match Simulation::new(&model, &scene, None, Some(solver)) {
-            Ok(sim) => {
+            Ok(mut sim) => {
+                sim.world.settings.sleeping = self.sleeping;
                 self.sim = Some(sim);
                 self.inform(String::new());
             }
@@ -576,6 +580,14 @@ impl RoboSimApp {
             {
                 sim.world.settings.contact_solver = self.solver;
             }
+            if ui
+                .checkbox(&mut self.sleeping, "Sleep")
+                .on_hover_text("Bodies at rest for half a second sleep and cost nothing until something touches them, a motor on them starts or you drag them")
+                .changed()
+                && let Some(sim) = &mut self.sim
+            {
+                sim.world.settings.sleeping = self.sleeping;
+            }
             ui.separator();
             if matches!(self.selection, Some(Selection::Robot(_))) {
                 let joint = self.tool == tools::Tool::Joint;
@@ -611,6 +623,7 @@ impl RoboSimApp {
                 ui.checkbox(&mut self.debug.centres, "Centres of mass");
                 ui.checkbox(&mut self.debug.velocities, "Velocities");
                 ui.checkbox(&mut self.debug.grid, "Grid");
+                ui.checkbox(&mut self.debug.sleeping, "Sleeping bodies (faded, \"z\")");
 
             });
         });

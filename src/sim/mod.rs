@@ -245,8 +245,10 @@ impl Simulation {
             self.dt,
             self.solver,
         );
+        let sleeping = self.world.settings.sleeping;
         *self = Self::new(&model, &name, Some(dt), Some(solver))
             .expect("a scene that built once builds again");
+        self.world.settings.sleeping = sleeping;
     }
 
     pub fn step_count(&self) -> u64 {
