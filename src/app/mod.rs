@@ -512,7 +512,7 @@ impl RoboSimApp {
             let typed = ui.add(
                 egui::TextEdit::singleline(&mut self.path_input)
                     .hint_text("database folder")
-                    .desired_width(180.0),
+                    .desired_width(140.0),
             );
             let typed = typed.on_hover_text("Type a folder and press Enter (for machines without a file dialog)");
             if typed.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter)) && !self.path_input.is_empty() {
@@ -557,6 +557,7 @@ impl RoboSimApp {
                 self.reset();
             }
             egui::ComboBox::from_id_salt("speed")
+                .width(56.0)
                 .selected_text(format!("{}×", self.speed))
                 .show_ui(ui, |ui| {
                     for s in SPEEDS {
@@ -567,6 +568,7 @@ impl RoboSimApp {
                 .on_hover_text("Slow motion and fast-forward: more or fewer steps per second, the step h never changes");
             let before = self.solver;
             egui::ComboBox::from_id_salt("solver")
+                .width(80.0)
                 .selected_text(self.solver.name())
                 .show_ui(ui, |ui| {
                     for s in ContactSolver::ALL {
@@ -603,6 +605,7 @@ impl RoboSimApp {
                 }
             }
             egui::ComboBox::from_id_salt("snap")
+                .width(72.0)
                 .selected_text(match self.snap_step {
                     Some(s) => format!("snap {s}"),
                     None => "snap off".into(),
