@@ -161,6 +161,8 @@ const SLEEP_AFTER: f64 = 0.5;
 struct Scratch {
     sleep_union: UnionFind,
     wake_labels: Vec<u32>,
+    asleep: Vec<usize>,
+    island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
     boxes: Vec<Option<Aabb>>,
     broad_phase: SweepAndPrune,
@@ -415,13 +417,11 @@ impl World {
         let margin = self.settings.contact_margin();
         let mut wake = std::mem::take(&mut self.scratch.wake_labels);
         wake.clear();
-        let asleep: Vec<usize> = (0..self.bodies.len())
-            .filter(|&i| self.bodies[i].as_ref().is_some_and(|b| b.asleep))
-            .collect();
-        if asleep.is_empty() {
-            self.scratch.wake_labels = wake;
-            return;
-        }
+        let mut asleep = std::mem::take(&mut self.scratch.asleep);
+        asleep.clear();
+        asleep.extend(
+            (0..self.bodies.len()).filter(|&i| self.bodies[i].as_ref().is_some_and(|b| b.asleep)),
+        );
         for awake in self.bodies.iter().flatten().filter(|b| !b.is_fixed()) {
             let reach = (awake.velocity.norm()
                 + awake.angular_velocity.abs() * awake.bounding_radius()
@@ -458,6 +458,7 @@ impl World {
             self.wake_island(label);
         }
         self.scratch.wake_labels = wake;
+        self.scratch.asleep = asleep;
     }
 
     /// Times how long each awake body has been still, and puts to sleep the islands whose
@@ -496,7 +497,9 @@ impl World {
         }
         // An island may sleep when its stillest-to-be body has waited long enough and no
         // motor in it runs.
-        let mut ready = vec![true; n];
+        let mut ready = std::mem::take(&mut self.scratch.island_ready);
+        ready.clear();
+        ready.resize(n, true);
         for i in 0..n as u32 {
             if let Some(b) = self.bodies[i as usize].as_ref()
                 && !b.is_fixed()
@@ -530,6 +533,7 @@ impl World {
                 self.sleep_labels[i as usize] = root;
             }
         }
+        self.scratch.island_ready = ready;
     }
 
     fn step_impulses(&mut self, dt: f64) {
