@@ -14,19 +14,24 @@ fn run(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-#[test]
-fn run_writes_parseable_json_lines_at_0_every_k_and_the_last_step() {
-    let out = run(&["--scene", "stack of boxes", "--steps", "10", "--every", "4"]);
+/// The JSON Lines records of a successful run.
+fn json_records(out: std::process::Output) -> Vec<serde_json::Value> {
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let records: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+    String::from_utf8(out.stdout)
         .unwrap()
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+        .collect()
+}
+
+#[test]
+fn run_writes_parseable_json_lines_at_0_every_k_and_the_last_step() {
+    let out = run(&["--scene", "stack of boxes", "--steps", "10", "--every", "4"]);
+    let records = json_records(out);
     let steps: Vec<u64> = records
         .iter()
         .map(|r| r["step"].as_u64().unwrap())
@@ -227,16 +232,7 @@ fn sleep_lets_the_stack_of_boxes_come_exactly_to_rest() {
         "600",
         "--sleep",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let records: Vec<serde_json::Value> = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    let records = json_records(out);
     let (middle, last) = (&records[1], &records[2]);
     for (a, b) in middle["bodies"]
         .as_array()

@@ -151,23 +151,29 @@ fn stack(
     (w, boxes)
 }
 
+/// Steps 10 s and returns the fastest any body moved after the first 2 s.
+fn fastest_after_settling(w: &mut World) -> f64 {
+    let mut late_speed: f64 = 0.0;
+    for step in 0..600 {
+        w.step(H);
+        if step >= 120 {
+            let fastest = w
+                .bodies()
+                .map(|(_, b)| b.velocity.norm())
+                .fold(0.0, f64::max);
+            late_speed = late_speed.max(fastest);
+        }
+    }
+    late_speed
+}
+
 #[test]
 fn stack_of_ten_stands_still() {
     for solver in [ContactSolver::Exact, ContactSolver::Thesis] {
         let (mut w, boxes) = stack(solver, 10, 0.6, |_| 0.0);
         let top = *boxes.last().unwrap();
         let start = w.body(top).unwrap().position;
-        let mut late_speed: f64 = 0.0;
-        for step in 0..600 {
-            w.step(H);
-            if step >= 120 {
-                let fastest = w
-                    .bodies()
-                    .map(|(_, b)| b.velocity.norm())
-                    .fold(0.0, f64::max);
-                late_speed = late_speed.max(fastest);
-            }
-        }
+        let late_speed = fastest_after_settling(&mut w);
         let drift = (w.body(top).unwrap().position - start).x.abs();
         assert!(drift < 0.01, "{solver:?}: top drifted {drift}");
         // After settling nothing moves faster than gravity adds in one step (g·h ≈ 0.17).
@@ -296,17 +302,7 @@ fn a_stack_of_fifteen_with_random_offsets_stands_ten_seconds() {
     for solver in SIMULTANEOUS {
         let (mut w, boxes) = stack(solver, 15, 0.3, &offsets);
         let start: Vec<Vec2> = boxes.iter().map(|&b| w.body(b).unwrap().position).collect();
-        let mut late_speed: f64 = 0.0;
-        for step in 0..600 {
-            w.step(H);
-            if step >= 120 {
-                let fastest = w
-                    .bodies()
-                    .map(|(_, b)| b.velocity.norm())
-                    .fold(0.0, f64::max);
-                late_speed = late_speed.max(fastest);
-            }
-        }
+        let late_speed = fastest_after_settling(&mut w);
         // Standing: no box has slid sideways by 1% of its width or tipped by a degree.
         for (i, &b) in boxes.iter().enumerate() {
             let body = w.body(b).unwrap();

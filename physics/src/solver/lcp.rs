@@ -91,15 +91,6 @@ const PGS_TOLERANCE: f64 = 1e-10;
 impl LcpSolver {
     /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
     pub fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
-        self.solve_with(p, x, true)
-    }
-
-    /// Solves by projected Gauss–Seidel only: the iterative fallback for big islands.
-    pub fn solve_iterative(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
-        self.solve_with(p, x, false)
-    }
-
-    fn solve_with(&mut self, p: &LcpProblem, x: &mut Vec<f64>, pivoting: bool) -> LcpStats {
         let n = p.n;
         x.clear();
         x.resize(n, 0.0);
@@ -117,7 +108,7 @@ impl LcpSolver {
         let has_friction_rows = p
             .friction_index
             .is_some_and(|f| f.iter().any(Option::is_some));
-        let rounds = if pivoting && has_friction_rows {
+        let rounds = if has_friction_rows {
             FRICTION_ROUNDS
         } else {
             1
@@ -128,7 +119,7 @@ impl LcpSolver {
         for _ in 0..rounds {
             self.previous.clone_from(&self.x);
             self.update_friction_bounds(p);
-            let ok = pivoting && self.pivot(&mut stats.pivots);
+            let ok = self.pivot(&mut stats.pivots);
             if !ok {
                 method = LcpMethod::ProjectedGaussSeidel;
                 self.x.clone_from(&self.previous);

@@ -6,7 +6,7 @@ use super::SolverBody;
 use super::contact::Contact;
 use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
-use super::lcp::{LcpProblem, LcpSolver};
+use super::lcp::{LcpProblem, LcpSolver, LcpStats};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
@@ -21,9 +21,12 @@ pub struct IslandReport {
     pub contacts: usize,
     pub joints: usize,
     pub rows: usize,
-    /// Whether the dense pivoting solve was used (else Gauss–Seidel).
+    /// Whether the dense pivoting solve was used (else Gauss–Seidel row by row).
     pub pivoting: bool,
+    /// Pivots made, or Gauss–Seidel sweeps.
     pub pivots: usize,
+    /// The LCP's complementarity residual (NaN for Gauss–Seidel row by row, which never
+    /// forms the matrix the residual is measured against).
     pub residual: f64,
 }
 
@@ -259,26 +262,35 @@ impl SimultaneousSolver {
         self.solve_rows(bodies, true);
     }
 
-    /// Solves the current rows and, if `apply`, applies their impulses.
+    /// Solves the current rows and, if `apply`, applies their impulses. Islands up to
+    /// `dense_row_limit` rows are solved by pivoting on the dense matrix, bigger ones by
+    /// Gauss–Seidel row by row.
     fn solve_rows(&mut self, bodies: &mut [SolverBody], apply: bool) {
         let n = self.rows.len();
-        if n > self.dense_row_limit {
-            let sweeps = self.solve_rows_sparse(bodies);
-            if apply {
-                for (row, &x) in self.rows.iter().zip(&self.x) {
-                    row.apply(bodies, x);
-                }
-                self.reports.push(IslandReport {
-                    contacts: self.island_contacts.len(),
-                    joints: self.island_joints.len(),
-                    rows: n,
-                    pivoting: false,
-                    pivots: sweeps,
-                    residual: f64::NAN,
-                });
+        let pivoting = n <= self.dense_row_limit;
+        let (pivots, residual) = if pivoting {
+            let stats = self.solve_rows_dense(bodies);
+            (stats.pivots, stats.residual)
+        } else {
+            (self.solve_rows_sparse(bodies), f64::NAN)
+        };
+        if apply {
+            for (row, &x) in self.rows.iter().zip(&self.x) {
+                row.apply(bodies, x);
             }
-            return;
+            self.reports.push(IslandReport {
+                contacts: self.island_contacts.len(),
+                joints: self.island_joints.len(),
+                rows: n,
+                pivoting,
+                pivots,
+                residual,
+            });
         }
+    }
+
+    /// The boxed LCP of the rows, assembled densely and solved by pivoting, into `x`.
+    fn solve_rows_dense(&mut self, bodies: &[SolverBody]) -> LcpStats {
         assemble(&self.rows, bodies, &mut self.a);
         self.b.clear();
         self.lo.clear();
@@ -291,32 +303,14 @@ impl SimultaneousSolver {
             self.friction_index.push(r.friction_of);
         }
         let problem = LcpProblem {
-            n,
+            n: self.rows.len(),
             a: &self.a,
             b: &self.b,
             lo: &self.lo,
             hi: &self.hi,
             friction_index: Some(&self.friction_index),
         };
-        let pivoting = n <= self.dense_row_limit;
-        let stats = if pivoting {
-            self.lcp.solve(&problem, &mut self.x)
-        } else {
-            self.lcp.solve_iterative(&problem, &mut self.x)
-        };
-        if apply {
-            for (row, &x) in self.rows.iter().zip(&self.x) {
-                row.apply(bodies, x);
-            }
-            self.reports.push(IslandReport {
-                contacts: self.island_contacts.len(),
-                joints: self.island_joints.len(),
-                rows: n,
-                pivoting,
-                pivots: stats.pivots,
-                residual: stats.residual,
-            });
-        }
+        self.lcp.solve(&problem, &mut self.x)
     }
 
     /// Projected Gauss–Seidel on the rows themselves, for islands too big for a dense
