@@ -385,8 +385,10 @@ impl World {
         }
         if self.settings.sleeping {
             self.sleep_where_still(dt);
-        } else if self.bodies.iter().flatten().any(|b| b.asleep) {
+        } else if !self.sleep_labels.is_empty() {
+            // Sleeping was switched off: wake everyone, once.
             self.bodies.iter_mut().flatten().for_each(Body::wake);
+            self.sleep_labels.clear();
         }
     }
 
@@ -933,6 +935,7 @@ impl World {
             ContactSolver::Sequential | ContactSolver::Soft => solve_sequential(
                 &mut self.contacts,
                 &mut s.solver_bodies,
+                dt,
                 targets.bounce_below,
             ),
             ContactSolver::Thesis | ContactSolver::Exact => {

@@ -52,6 +52,8 @@ pub struct SimultaneousSolver {
     pseudo: Vec<SolverBody>,
     /// Velocities of an island's bodies during the row-by-row Gauss–Seidel.
     sparse_bodies: Vec<SolverBody>,
+    /// Each row's `A_ii`, for the row-by-row Gauss–Seidel.
+    diagonals: Vec<f64>,
     stage_one: Vec<f64>,
     island_contacts: Vec<(u32, Contact)>,
     island_joints: Vec<JointConstraint>,
@@ -332,19 +334,10 @@ impl SimultaneousSolver {
         }
         // w_i = (row velocity now) + offset_i, where offset_i = b_i − (velocity at start).
         self.b.clear();
-        self.lo.clear();
+        self.diagonals.clear();
         for row in &self.rows {
-            let start = row.velocity(bodies);
-            self.b.push(row.b - start);
-            let diagonal: f64 = row
-                .ends
-                .iter()
-                .map(|e| {
-                    let t = &bodies[e.body as usize];
-                    t.inv_mass * e.linear.norm_squared() + t.inv_inertia * e.angular * e.angular
-                })
-                .sum();
-            self.lo.push(diagonal); // reused as the diagonal
+            self.b.push(row.b - row.velocity(bodies));
+            self.diagonals.push(row.diagonal(bodies));
         }
         let mut sweeps = 0;
         while sweeps < SWEEPS {
@@ -353,7 +346,7 @@ impl SimultaneousSolver {
             let mut size: f64 = 0.0;
             for i in 0..n {
                 let row = &self.rows[i];
-                let diagonal = self.lo[i];
+                let diagonal = self.diagonals[i];
                 if diagonal <= 0.0 {
                     continue;
                 }

@@ -49,6 +49,17 @@ impl Row {
             .sum()
     }
 
+    /// How much a unit impulse along the row changes the row's own velocity: `A_ii`.
+    pub fn diagonal(&self, bodies: &[SolverBody]) -> f64 {
+        self.ends
+            .iter()
+            .map(|e| {
+                let t = &bodies[e.body as usize];
+                t.inv_mass * e.linear.norm_squared() + t.inv_inertia * e.angular * e.angular
+            })
+            .sum()
+    }
+
     /// Applies impulse `x` along the row (its Jacobian transposed, scaled by M⁻¹).
     pub fn apply(&self, bodies: &mut [SolverBody], x: f64) {
         for e in &self.ends {
@@ -118,17 +129,7 @@ pub fn velocity_rows(
             friction_of: None,
         };
         let v_n = row.velocity(bodies);
-        row.b = if c.bounces(targets.dt, targets.bounce_below) {
-            // (19): v_n' ≥ −e·v_n, with v_n the approach before this step's forces.
-            v_n + c.restitution * c.approach_velocity.min(0.0)
-        } else if c.depth < 0.0 {
-            // Apart: they may approach by the gap this step, and no further. (Stopping
-            // them where they are would leave a body hovering up to g·h² above the
-            // ground: 3 mm at 60 Hz, three body sizes for a 1 mm part.)
-            v_n - c.depth / targets.dt
-        } else {
-            v_n
-        };
+        row.b = v_n - c.min_normal_velocity(targets.dt, targets.bounce_below);
         rows.push(row);
         if targets.friction {
             let ends = point_row(c.body_a, c.body_b, c.point, c.point, c.tangent(), bodies);
