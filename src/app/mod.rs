@@ -359,32 +359,17 @@ impl RoboSimApp {
         let mut draft = self.db.model.clone();
         let selection = match sel {
             Selection::Body(n) => {
-                let names: Vec<String> = draft.bodies.iter().map(|b| b.name.clone()).collect();
-                let Some(mut b) = draft.body(&n).cloned() else {
-                    return;
-                };
-                b.name = inspector::unique(&names, &format!("{n} copy"));
-                draft.bodies.push(b.clone());
-                Selection::Body(b.name)
+                push_copy(&mut draft.bodies, &n, |b| &mut b.name).map(Selection::Body)
             }
             Selection::Robot(n) => {
-                let names: Vec<String> = draft.robots.iter().map(|r| r.name.clone()).collect();
-                let Some(mut r) = draft.robot(&n).cloned() else {
-                    return;
-                };
-                r.name = inspector::unique(&names, &format!("{n} copy"));
-                draft.robots.push(r.clone());
-                Selection::Robot(r.name)
+                push_copy(&mut draft.robots, &n, |r| &mut r.name).map(Selection::Robot)
             }
             Selection::Scene(n) => {
-                let names: Vec<String> = draft.scenes.iter().map(|s| s.name.clone()).collect();
-                let Some(mut s) = draft.scene(&n).cloned() else {
-                    return;
-                };
-                s.name = inspector::unique(&names, &format!("{n} copy"));
-                draft.scenes.push(s.clone());
-                Selection::Scene(s.name)
+                push_copy(&mut draft.scenes, &n, |s| &mut s.name).map(Selection::Scene)
             }
+        };
+        let Some(selection) = selection else {
+            return;
         };
         self.commit(draft, "duplicate", now);
         self.select(selection);
@@ -1204,6 +1189,21 @@ impl RoboSimApp {
     }
 }
 
+/// Appends a copy of the item named `name` under a free "… copy" name; returns that name.
+fn push_copy<T: Clone>(
+    items: &mut Vec<T>,
+    name: &str,
+    name_of: fn(&mut T) -> &mut String,
+) -> Option<String> {
+    let taken: Vec<String> = items.iter_mut().map(|i| name_of(i).clone()).collect();
+    let index = taken.iter().position(|t| t == name)?;
+    let mut copy = items[index].clone();
+    let new_name = inspector::unique(&taken, &format!("{name} copy"));
+    *name_of(&mut copy) = new_name.clone();
+    items.push(copy);
+    Some(new_name)
+}
+
 /// The name of the synthetic scene a robot or body is previewed in.
 const PREVIEW: &str = "\u{0}preview";
 
@@ -1329,5 +1329,28 @@ impl eframe::App for RoboSimApp {
     fn save(&mut self, storage: &mut dyn eframe::Storage) {
         self.autosave();
         eframe::set_value(storage, RECENT_KEY, &self.recent);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::BodyDef;
+
+    #[test]
+    fn a_duplicate_gets_the_first_free_copy_name_and_the_same_contents() {
+        let body = |name: &str| BodyDef {
+            name: name.to_string(),
+            density: 2.0,
+            ..BodyDef::default()
+        };
+        let mut bodies = vec![body("box"), body("box copy")];
+        assert_eq!(
+            push_copy(&mut bodies, "box", |b| &mut b.name).as_deref(),
+            Some("box copy 2")
+        );
+        assert_eq!(bodies[2], body("box copy 2"));
+        assert_eq!(push_copy(&mut bodies, "nothing", |b| &mut b.name), None);
+        assert_eq!(bodies.len(), 3);
     }
 }
