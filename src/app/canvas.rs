@@ -474,10 +474,7 @@ pub fn edit_vertices(
     }
     let to_screen = |v: &[f64; 2]| camera.to_screen(rect, Vec2::new(v[0], v[1]));
     let points: Vec<Pos2> = vertices.iter().map(to_screen).collect();
-    let valid = {
-        let pts: Vec<Vec2> = vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect();
-        pe::ConvexPolygon::new(&pts)
-    };
+    let valid = crate::db::outline_polygon(vertices);
     let colour = if valid.is_ok() {
         Color32::from_rgb(90, 200, 120)
     } else {

@@ -2,6 +2,7 @@
 //! at a point, snapping to the grid. The canvas turns clicks into calls; tests call them
 //! directly.
 
+use crate::db::outline_polygon;
 use crate::model::{JointDef, Model, Placement, Robot};
 use pe::Vec2;
 
@@ -53,24 +54,19 @@ pub fn add_vertex(vertices: &[[f64; 2]], p: [f64; 2]) -> Result<Vec<[f64; 2]>, S
     for (_, i) in edges {
         let mut v = vertices.to_vec();
         v.insert(i + 1, p);
-        if polygon(&v).is_ok() {
+        if outline_polygon(&v).is_ok() {
             return Ok(v);
         }
         candidates.push(v);
     }
     let reason = candidates
         .first()
-        .and_then(|v| polygon(v).err())
+        .and_then(|v| outline_polygon(v).err())
         .map_or_else(String::new, |e| format!(" ({e})"));
     Err(format!(
         "a vertex at ({}, {}) would make the body non-convex{reason}; Shift+click adds it anyway, then Convex hull repairs the outline",
         p[0], p[1]
     ))
-}
-
-fn polygon(v: &[[f64; 2]]) -> Result<pe::ConvexPolygon, pe::ShapeError> {
-    let pts: Vec<Vec2> = v.iter().map(|p| Vec2::new(p[0], p[1])).collect();
-    pe::ConvexPolygon::new(&pts)
 }
 
 fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
@@ -79,30 +75,18 @@ fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
     (a + ab * t - p).norm()
 }
 
-/// A placed body's outline in its parent's frame (world = origin + R(orientation)·local).
-pub fn placed_outline(model: &Model, placement: &Placement) -> Option<Vec<Vec2>> {
-    let def = model.body(&placement.source)?;
-    let (s, c) = placement.orientation.sin_cos();
-    Some(
-        def.vertices
-            .iter()
-            .map(|v| {
-                Vec2::new(
-                    placement.x + c * v[0] - s * v[1],
-                    placement.y + s * v[0] + c * v[1],
-                )
-            })
-            .collect(),
-    )
-}
-
-fn contains(outline: &[Vec2], p: Vec2) -> bool {
-    let n = outline.len();
-    if n < 3 {
+/// Whether the body placed by `placement` covers `p` (in the placement's parent frame).
+fn covers(model: &Model, placement: &Placement, p: Vec2) -> bool {
+    let Some(polygon) = model
+        .body(&placement.source)
+        .and_then(|d| outline_polygon(&d.vertices).ok())
+    else {
         return false;
-    }
-    let side = |k: usize| pe::math::cross(outline[(k + 1) % n] - outline[k], p - outline[k]);
-    (0..n).all(|k| side(k) >= 0.0) || (0..n).all(|k| side(k) <= 0.0)
+    };
+    // Into the body's own frame: p_local = R(−orientation)·(p − origin).
+    let (s, c) = placement.orientation.sin_cos();
+    let d = p - Vec2::new(placement.x, placement.y);
+    polygon.contains(Vec2::new(c * d.x + s * d.y, -s * d.x + c * d.y))
 }
 
 /// The aliases of `robot`'s bodies whose outlines cover `p` (robot coordinates), topmost
@@ -112,7 +96,7 @@ pub fn bodies_at(model: &Model, robot: &Robot, p: Vec2) -> Vec<String> {
         .bodies
         .iter()
         .rev()
-        .filter(|b| placed_outline(model, &b.placement).is_some_and(|o| contains(&o, p)))
+        .filter(|b| covers(model, &b.placement, p))
         .map(|b| b.placement.alias.clone())
         .collect()
 }
@@ -175,7 +159,7 @@ mod tests {
     fn a_vertex_goes_into_its_nearest_edge_and_a_dent_is_refused() {
         let v = add_vertex(&square(), [5.0, -3.0]).unwrap();
         assert_eq!(v[1], [5.0, -3.0], "between (0,0) and (10,0)");
-        assert!(polygon(&v).is_ok());
+        assert!(outline_polygon(&v).is_ok());
         let err = add_vertex(&square(), [5.0, 5.0]).unwrap_err();
         assert!(err.contains("non-convex"), "{err}");
         assert!(
@@ -188,7 +172,7 @@ mod tests {
             drawn = add_vertex(&drawn, p).unwrap();
         }
         assert_eq!(drawn.len(), 3);
-        assert!(polygon(&drawn).is_ok());
+        assert!(outline_polygon(&drawn).is_ok());
     }
 
     #[test]

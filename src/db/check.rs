@@ -75,11 +75,12 @@ fn duplicates<'a>(
 
 /// The body's polygon, or why it is not one.
 pub fn polygon(body: &BodyDef) -> Result<ConvexPolygon, pe::ShapeError> {
-    let points: Vec<Vec2> = body
-        .vertices
-        .iter()
-        .map(|v| Vec2::new(v[0], v[1]))
-        .collect();
+    outline_polygon(&body.vertices)
+}
+
+/// The polygon of an outline as the files store it (the editor checks drafts with it).
+pub fn outline_polygon(vertices: &[[f64; 2]]) -> Result<ConvexPolygon, pe::ShapeError> {
+    let points: Vec<Vec2> = vertices.iter().map(|v| Vec2::new(v[0], v[1])).collect();
     ConvexPolygon::new(&points)
 }
 
