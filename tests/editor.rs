@@ -53,6 +53,31 @@ fn click_world(h: &mut Harness<'_, RoboSimApp>, x: f64, y: f64, modifiers: Modif
     h.run_steps(1);
 }
 
+/// Drags on the canvas with the primary button from world point `from` to `to`.
+fn drag_world(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64)) {
+    let app = h.state();
+    let screen = |(x, y): (f64, f64)| app.camera.to_screen(app.canvas_rect, pe::Vec2::new(x, y));
+    let (start, end) = (screen(from), screen(to));
+    h.event(Event::PointerMoved(start));
+    h.run_steps(1);
+    let button = |pos, pressed| Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    };
+    h.event(button(start, true));
+    h.run_steps(1);
+    for k in 1..=4 {
+        h.event(Event::PointerMoved(
+            start + (end - start) * (k as f32 / 4.0),
+        ));
+        h.run_steps(1);
+    }
+    h.event(button(end, false));
+    h.run_steps(2);
+}
+
 fn click(h: &mut Harness<'_, RoboSimApp>, label: &str) {
     h.get_by_label(label).click();
     h.run_steps(2);
@@ -294,4 +319,45 @@ fn undo_and_redo_round_trip_inspector_and_canvas_edits() {
     assert_eq!(h.state().db.model, with_body);
     click(&mut h, "Redo");
     assert_eq!(h.state().db.model.bodies.len(), with_body.bodies.len() - 1);
+}
+
+#[test]
+fn dragging_and_turning_a_body_at_step_0_edits_its_placement_in_the_scene() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    click(&mut h, "Pause");
+    click(&mut h, "Reset");
+    let placement = |h: &Harness<'_, RoboSimApp>| {
+        let scene = h.state().db.model.scene("stack of boxes").unwrap().clone();
+        let b = scene
+            .bodies
+            .iter()
+            .find(|b| b.alias == "box 1")
+            .unwrap()
+            .clone();
+        (b.x, b.y, b.orientation)
+    };
+    assert_eq!(placement(&h), (400.0, 365.0, 0.0));
+    // Grab box 1 (400, 365) a little off its origin and move it 60.2 to the right: the
+    // grabbed point follows the pointer and the origin snaps to the 0.5 grid.
+    drag_world(&mut h, (402.0, 366.0), (462.2, 366.0));
+    let (x, y, o) = placement(&h);
+    assert_eq!(
+        (x, y, o),
+        (460.0, 365.0, 0.0),
+        "status: {}",
+        h.state().status
+    );
+    h.key_press(Key::E);
+    h.run_steps(2);
+    let (_, _, o) = placement(&h);
+    assert!((o - 15f64.to_radians()).abs() < 1e-12, "orientation {o}");
+    // One undo per gesture.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run_steps(2);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run_steps(2);
+    assert_eq!(placement(&h), (400.0, 365.0, 0.0));
 }

@@ -166,16 +166,27 @@ pub fn show(
     if editing && !selecting && response.clicked() {
         outcome.tool_click = pointer_world;
     }
+    // A drag is recognised only once the pointer has moved a few pixels: pick and grab
+    // where the button went down, not where the pointer is by then.
+    let press_world = ui
+        .input(|i| i.pointer.press_origin())
+        .map(|p| camera.to_world(rect, p));
+    let drag_started = response.drag_started_by(egui::PointerButton::Primary);
     let offset_id = response.id.with("placement drag offset");
-    if selecting && (response.drag_started_by(egui::PointerButton::Primary) || response.clicked()) {
-        let hit = pointer_world.and_then(|p| body_at(sim, p));
+    if selecting && (drag_started || response.clicked()) {
+        let picked_at = if drag_started {
+            press_world
+        } else {
+            pointer_world
+        };
+        let hit = picked_at.and_then(|p| body_at(sim, p));
         if *selected != hit {
             *selected = hit;
             outcome.selection_changed = true;
         }
-        if response.drag_started_by(egui::PointerButton::Primary)
+        if drag_started
             && !editing
-            && let (Some(i), Some(p)) = (hit, pointer_world)
+            && let (Some(i), Some(p)) = (hit, picked_at)
             && let Some(body) = sim.world.body(sim.bodies[i].handle)
             && !body.is_static()
         {
@@ -200,9 +211,10 @@ pub fn show(
             .and_then(|b| sim.world.body(b.handle))
             .map(|b| b.origin())
     {
-        if response.drag_started_by(egui::PointerButton::Primary) {
-            ui.data_mut(|d| d.insert_temp(offset_id, p - origin));
-        } else if response.dragged_by(egui::PointerButton::Primary)
+        if drag_started && let Some(pressed) = press_world {
+            ui.data_mut(|d| d.insert_temp(offset_id, pressed - origin));
+        }
+        if response.dragged_by(egui::PointerButton::Primary)
             && response.drag_delta() != egui::Vec2::ZERO
             && let Some(offset) = ui.data(|d| d.get_temp::<Vec2>(offset_id))
         {

@@ -11,7 +11,7 @@ pub mod undo;
 
 use crate::db::{Database, Delete, Overwrite, Problem, SaveError};
 use crate::model::{Model, Scene, SceneRobot};
-use crate::sim::Simulation;
+use crate::sim::{PlacedBy, Simulation};
 use camera::Camera;
 use canvas::{DebugDraw, Grab};
 use pe::ContactSolver;
@@ -981,9 +981,9 @@ impl RoboSimApp {
     /// to `wanted` (snapped to the grid): a scene body, a whole robot in a scene, or a body
     /// within a robot.
     fn move_placement(&mut self, index: usize, wanted: pe::Vec2, now: f64) {
-        let Some((id, origin)) = self.sim.as_ref().and_then(|s| {
+        let Some(origin) = self.sim.as_ref().and_then(|s| {
             let b = s.bodies.get(index)?;
-            Some((b.id.clone(), s.world.body(b.handle)?.origin()))
+            Some(s.world.body(b.handle)?.origin())
         }) else {
             return;
         };
@@ -995,7 +995,7 @@ impl RoboSimApp {
         if delta.norm() < 1e-12 {
             return;
         }
-        self.edit_placement(&id, now, |x, y, _| {
+        self.edit_placement(index, now, |x, y, _| {
             *x += delta.x;
             *y += delta.y;
         });
@@ -1003,58 +1003,49 @@ impl RoboSimApp {
 
     /// Turns the placement behind simulated body `index` by `angle` about its origin.
     fn rotate_placement(&mut self, index: usize, angle: f64, now: f64) {
-        let Some(id) = self
-            .sim
-            .as_ref()
-            .and_then(|s| s.bodies.get(index))
-            .map(|b| b.id.clone())
-        else {
-            return;
-        };
-        self.edit_placement(&id, now, |_, _, o| *o += angle);
+        self.edit_placement(index, now, |_, _, o| *o += angle);
     }
 
-    /// Edits (x, y, orientation) of the placement that puts simulated body `id` where it is.
+    /// Edits (x, y, orientation) of the placement that puts simulated body `index` where it
+    /// is: in a scene, the scene body or the whole robot; in a robot, the body's place in it.
     fn edit_placement(
         &mut self,
-        id: &str,
+        index: usize,
         now: f64,
         edit: impl FnOnce(&mut f64, &mut f64, &mut f64),
     ) {
+        let Some(body) = self.sim.as_ref().and_then(|s| s.bodies.get(index)).cloned() else {
+            return;
+        };
         let mut draft = self.db.model.clone();
-        match &self.selection {
-            Some(Selection::Scene(name)) => {
+        match (&self.selection, body.placed_by) {
+            (Some(Selection::Scene(name)), placed_by) => {
                 let Some(scene) = draft.scenes.iter_mut().find(|s| &s.name == name) else {
                     return;
                 };
-                match id
-                    .split_once('/')
-                    .and_then(|(robot, _)| robot.rsplit_once('#'))
-                {
-                    Some((_, i)) => {
-                        let Some(r) = i
-                            .parse::<usize>()
-                            .ok()
-                            .and_then(|i| scene.robots.get_mut(i))
-                        else {
-                            return;
-                        };
-                        edit(&mut r.x, &mut r.y, &mut r.orientation);
-                    }
-                    None => {
-                        let Some(b) = scene.bodies.iter_mut().find(|b| b.alias == id) else {
-                            return;
-                        };
-                        edit(&mut b.x, &mut b.y, &mut b.orientation);
-                    }
-                }
-            }
-            Some(Selection::Robot(name)) => {
-                let Some(robot) = draft.robots.iter_mut().find(|r| &r.name == name) else {
+                let placement = match placed_by {
+                    PlacedBy::SceneBody(k) => scene
+                        .bodies
+                        .get_mut(k)
+                        .map(|b| (&mut b.x, &mut b.y, &mut b.orientation)),
+                    PlacedBy::RobotBody { robot, .. } => scene
+                        .robots
+                        .get_mut(robot)
+                        .map(|r| (&mut r.x, &mut r.y, &mut r.orientation)),
+                };
+                let Some((x, y, o)) = placement else {
                     return;
                 };
-                let alias = id.split_once('/').map_or(id, |(_, a)| a);
-                let Some(b) = robot.bodies.iter_mut().find(|b| b.placement.alias == alias) else {
+                edit(x, y, o);
+            }
+            // The robot preview places the robot alone at the origin.
+            (Some(Selection::Robot(name)), PlacedBy::RobotBody { body: k, .. }) => {
+                let Some(b) = draft
+                    .robots
+                    .iter_mut()
+                    .find(|r| &r.name == name)
+                    .and_then(|r| r.bodies.get_mut(k))
+                else {
                     return;
                 };
                 let p = &mut b.placement;
@@ -1062,7 +1053,7 @@ impl RoboSimApp {
             }
             _ => return,
         }
-        self.commit(draft, &format!("place {id}"), now);
+        self.commit(draft, &format!("place {}", body.id), now);
     }
 
     fn dialogs(&mut self, ctx: &egui::Context, now: f64) {

@@ -22,6 +22,17 @@ pub struct SimBody {
     /// The alias of a scene body, `"{source}#{i}/{alias}"` for a body of the i-th robot.
     pub id: String,
     pub handle: BodyHandle,
+    pub placed_by: PlacedBy,
+}
+
+/// The placement in the files that puts a simulated body where it starts (indices in
+/// document order), so that the editor can change it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlacedBy {
+    /// The scene's `k`-th `<body>`.
+    SceneBody(usize),
+    /// Body `body` of the robot placed by the scene's `robot`-th `<robot>`.
+    RobotBody { robot: usize, body: usize },
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -128,6 +139,7 @@ impl Simulation {
     fn add_body(
         &mut self,
         id: String,
+        placed_by: PlacedBy,
         placement: &Placement,
         at: (Vec2, f64),
     ) -> Result<BodyHandle, String> {
@@ -146,7 +158,11 @@ impl Simulation {
             .world
             .add_body(body)
             .map_err(|e| format!("{id}: {e}"))?;
-        self.bodies.push(SimBody { id, handle });
+        self.bodies.push(SimBody {
+            id,
+            handle,
+            placed_by,
+        });
         Ok(handle)
     }
 
@@ -161,10 +177,11 @@ impl Simulation {
             let prefix = format!("{}#{i}", robot.name);
             let frame = (placed.x, placed.y, placed.orientation);
             let mut handles = Vec::new();
-            for b in &robot.bodies {
+            for (k, b) in robot.bodies.iter().enumerate() {
                 let p = &b.placement;
                 let id = format!("{prefix}/{}", p.alias);
-                let handle = self.add_body(id, p, compose(frame, placement_frame(p)))?;
+                let placed_by = PlacedBy::RobotBody { robot: i, body: k };
+                let handle = self.add_body(id, placed_by, p, compose(frame, placement_frame(p)))?;
                 for m in &b.motors {
                     self.world.add_body_motor(
                         handle,
@@ -230,8 +247,9 @@ impl Simulation {
                 });
             }
         }
-        for p in &scene.bodies {
-            self.add_body(p.alias.clone(), p, (Vec2::new(p.x, p.y), p.orientation))?;
+        for (k, p) in scene.bodies.iter().enumerate() {
+            let at = (Vec2::new(p.x, p.y), p.orientation);
+            self.add_body(p.alias.clone(), PlacedBy::SceneBody(k), p, at)?;
         }
         self.world.settings.length_scale = length_scale(&self.world);
         Ok(())
