@@ -31,17 +31,6 @@ pub fn show(
         }
     };
     let body_names: Vec<String> = draft.bodies.iter().map(|b| b.name.clone()).collect();
-    // Each body's width along x, for placing a new robot body next to the last.
-    let body_defs: Vec<(String, f64)> = draft
-        .bodies
-        .iter()
-        .map(|b| {
-            let xs = b.vertices.iter().map(|v| v[0]);
-            let width =
-                xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
-            (b.name.clone(), if width.is_finite() { width } else { 0.0 })
-        })
-        .collect();
     let robot_names: Vec<String> = draft.robots.iter().map(|r| r.name.clone()).collect();
     match selection {
         Selection::Body(name) => {
@@ -260,6 +249,11 @@ pub fn show(
             }
         }
         Selection::Robot(name) => {
+            let last_width = draft
+                .robot(name)
+                .and_then(|r| r.bodies.last())
+                .and_then(|b| draft.body(&b.placement.source))
+                .map_or(0.0, width_along_x);
             let Some(robot) = draft.robots.iter_mut().find(|r| &r.name == name) else {
                 return change;
             };
@@ -328,12 +322,7 @@ pub fn show(
                 // To the right of the last body, overlapping it by a quarter of its width:
                 // where the joint tool can pin the two.
                 let (x, y) = robot.bodies.last().map_or((0.0, 0.0), |last| {
-                    let p = &last.placement;
-                    let width = body_defs
-                        .iter()
-                        .find(|(n, _)| n == p.source.trim())
-                        .map_or(0.0, |(_, w)| *w);
-                    (p.x + 0.75 * width, p.y)
+                    (last.placement.x + 0.75 * last_width, last.placement.y)
                 });
                 robot.bodies.push(RobotBody {
                     placement: Placement {
@@ -847,6 +836,13 @@ fn pick(ui: &mut Ui, label: &str, names: &[String]) -> Option<String> {
             });
     });
     picked
+}
+
+/// The extent of a body's outline along its x axis (0 when it has no vertices).
+fn width_along_x(body: &crate::model::BodyDef) -> f64 {
+    let xs = body.vertices.iter().map(|v| v[0]);
+    let width = xs.clone().fold(f64::NEG_INFINITY, f64::max) - xs.fold(f64::INFINITY, f64::min);
+    if width.is_finite() { width } else { 0.0 }
 }
 
 /// `base`, or `base 2`, `base 3`, … whichever is not in `taken`.
