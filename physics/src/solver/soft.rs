@@ -9,8 +9,15 @@
 
 use super::SolverBody;
 use super::contact::Contact;
+use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
+use nalgebra::{DMatrix, DVector};
+
+/// Joint islands up to this many pins are solved as one linear system per pass (a dense
+/// Cholesky of 2m × 2m); larger ones pin by pin. One pass of pin-by-pin Gauss–Seidel
+/// cannot hold a light chain under a heavy load: the error travels one link per pass.
+const DIRECT_JOINT_LIMIT: usize = 64;
 
 /// Tuning of the soft step; defaults after Box2D v3, scaled by the world's length scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,7 +108,16 @@ struct PointConstraint {
     normal_impulse: f64,
     tangent_impulse: f64,
     max_normal_impulse: f64,
+    /// How fast gravity and forces close the gap (along −normal), for the impact speed.
+    closing_acceleration: f64,
+    /// With the next point: the off-diagonal of their 2 × 2 normal mass matrix, when the
+    /// two are one manifold's and the block is well conditioned (solved together).
+    pair_coupling: Option<f64>,
 }
+
+/// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
+/// condition number below this (Box2D v2's bound); nearly parallel rows go one by one.
+const MAX_BLOCK_CONDITION: f64 = 1000.0;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct SoftJoint {
@@ -117,6 +133,8 @@ struct SoftJoint {
     motor_step_total: f64,
     motor: Option<(f64, f64)>,
     slot: u32,
+    /// Its index in the step's input joints (the solver reorders them by island).
+    input: u32,
 }
 
 /// Warm-start memory and buffers, kept between steps.
@@ -129,6 +147,19 @@ pub struct SoftStepSolver {
     memory: Vec<((u32, u32, u32), f64, f64)>,
     next_memory: Vec<((u32, u32, u32), f64, f64)>,
     joint_memory: Vec<(u32, Vec2, f64)>,
+    /// `joints` index ranges, one per island of pins, and the buffers of their solve.
+    joint_islands: Vec<(usize, usize)>,
+    island_uf: UnionFind,
+    grouped: Vec<(u32, u32)>,
+    block: JointBlock,
+}
+
+/// The dense system of one island of pins, reused between passes.
+#[derive(Debug, Clone, Default)]
+struct JointBlock {
+    arms: Vec<(Vec2, Vec2)>,
+    k: DMatrix<f64>,
+    rhs: DVector<f64>,
 }
 
 /// The most a body may turn in one substep (radians).
@@ -163,7 +194,7 @@ impl SoftStepSolver {
             settings.joint_damping_ratio,
             h,
         );
-        self.prepare(bodies, contacts, joints);
+        self.prepare(bodies, accelerations, contacts, joints);
         for _ in 0..settings.substeps {
             self.integrate_velocities(accelerations, h);
             self.warm_start();
@@ -186,7 +217,13 @@ impl SoftStepSolver {
         self.store(bodies, contacts, joints);
     }
 
-    fn prepare(&mut self, bodies: &[SolverBody], contacts: &[Contact], joints: &[JointConstraint]) {
+    fn prepare(
+        &mut self,
+        bodies: &[SolverBody],
+        accelerations: &[(Vec2, f64)],
+        contacts: &[Contact],
+        joints: &[JointConstraint],
+    ) {
         self.bodies.clear();
         self.bodies.extend(bodies.iter().map(|b| SoftBody {
             v: b.velocity,
@@ -230,10 +267,32 @@ impl SoftStepSolver {
                 normal_impulse,
                 tangent_impulse,
                 max_normal_impulse: 0.0,
+                closing_acceleration: -(accelerations[c.body_a as usize].0
+                    - accelerations[c.body_b as usize].0)
+                    .dot(&c.normal),
+                pair_coupling: None,
             });
         }
+        for i in 1..self.points.len() {
+            let (p, q) = (&self.points[i - 1], &self.points[i]);
+            let same_manifold = p.a == q.a && p.b == q.b && p.normal == q.normal;
+            let taken = i >= 2 && self.points[i - 2].pair_coupling.is_some();
+            if !same_manifold || taken {
+                continue;
+            }
+            let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+            let n = p.normal;
+            let (a1, a2) = (cross(p.r_a, n), cross(q.r_a, n));
+            let (b1, b2) = (cross(p.r_b, n), cross(q.r_b, n));
+            let k12 = a.inv_mass + b.inv_mass + a.inv_inertia * a1 * a2 + b.inv_inertia * b1 * b2;
+            let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
+            let det = k11 * k22 - k12 * k12;
+            if p.normal_mass > 0.0 && q.normal_mass > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det {
+                self.points[i - 1].pair_coupling = Some(k12);
+            }
+        }
         self.joints.clear();
-        for j in joints {
+        for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
             let (r_a, r_b) = j.arms((a.angle, b.angle));
             let (impulse, motor_impulse) =
@@ -246,7 +305,10 @@ impl SoftStepSolver {
                 b: j.body_b,
                 r_a,
                 r_b,
-                base_gap: (a.position + r_a) - (b.position + r_b) - j.gap_target,
+                // The soft step always pulls towards a closed pin (a broken joint too),
+                // no faster than `max_push_speed`; the target the other solvers use to
+                // repair broken joints over several steps does not apply here.
+                base_gap: (a.position + r_a) - (b.position + r_b),
                 impulse,
                 motor_impulse,
                 motor_step_total: 0.0,
@@ -255,7 +317,43 @@ impl SoftStepSolver {
                     .filter(|m| m.enabled)
                     .map(|m| (m.target_speed, m.max_torque)),
                 slot: j.joint,
+                input: input as u32,
             });
+        }
+        self.group_joints();
+    }
+
+    /// Orders `joints` island by island (pins linked through moving bodies) and records
+    /// each island's range.
+    fn group_joints(&mut self) {
+        let bodies = &self.bodies;
+        let dynamic =
+            |i: u32| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0;
+        let joints = &self.joints;
+        group_by_island(
+            joints.len(),
+            bodies.len(),
+            |i| (joints[i].a, joints[i].b),
+            dynamic,
+            &mut self.island_uf,
+            &mut self.grouped,
+        );
+        let ordered: Vec<SoftJoint> = self
+            .grouped
+            .iter()
+            .map(|&(_, i)| joints[i as usize])
+            .collect();
+        self.joints = ordered;
+        self.joint_islands.clear();
+        let mut start = 0;
+        while start < self.grouped.len() {
+            let root = self.grouped[start].0;
+            let len = self.grouped[start..]
+                .iter()
+                .take_while(|g| g.0 == root)
+                .count();
+            self.joint_islands.push((start, start + len));
+            start += len;
         }
     }
 
@@ -303,7 +401,11 @@ impl SoftStepSolver {
             Self::apply(&mut self.bodies, p.a, p.b, p.r_a, p.r_b, impulse);
         }
         for j in &self.joints {
-            Self::apply(&mut self.bodies, j.a, j.b, j.r_a, j.r_b, j.impulse);
+            // A pin's impulse acts at its anchors where they are now: at the step's first
+            // arms, a tiny-inertia body far from its pin would be spun by the stale lever.
+            let ra = rotate_delta(self.bodies[j.a as usize].dq, j.r_a);
+            let rb = rotate_delta(self.bodies[j.b as usize].dq, j.r_b);
+            Self::apply(&mut self.bodies, j.a, j.b, ra, rb, j.impulse);
             let (a, b) = (j.a as usize, j.b as usize);
             let ia = self.bodies[a].inv_inertia;
             self.bodies[a].w += ia * j.motor_impulse;
@@ -321,33 +423,84 @@ impl SoftStepSolver {
         use_bias: bool,
     ) {
         for j in self.joints.iter_mut() {
-            solve_joint(&mut self.bodies, j, h, joint_soft, use_bias);
+            solve_motor(&mut self.bodies, j, h);
         }
-        for p in self.points.iter_mut() {
-            solve_point(&mut self.bodies, p, h, contact_soft, max_push, use_bias);
+        for &(start, end) in &self.joint_islands {
+            let island = &mut self.joints[start..end];
+            // A lone pin's 2 × 2 is solved in closed form below.
+            let solved = (2..=DIRECT_JOINT_LIMIT).contains(&island.len())
+                && self
+                    .block
+                    .solve(&mut self.bodies, island, joint_soft, max_push, use_bias);
+            if !solved {
+                for j in island.iter_mut() {
+                    solve_joint(&mut self.bodies, j, joint_soft, max_push, use_bias);
+                }
+            }
+        }
+        let mut i = 0;
+        while i < self.points.len() {
+            if self.points[i].pair_coupling.is_some() {
+                let (first, second) = self.points.split_at_mut(i + 1);
+                solve_pair(
+                    &mut self.bodies,
+                    (&mut first[i], &mut second[0]),
+                    h,
+                    contact_soft,
+                    max_push,
+                    use_bias,
+                );
+                i += 2;
+            } else {
+                solve_point(
+                    &mut self.bodies,
+                    &mut self.points[i],
+                    h,
+                    contact_soft,
+                    max_push,
+                    use_bias,
+                );
+                i += 1;
+            }
         }
     }
 
     /// Restitution once, after the substeps, for contacts that were approaching faster
     /// than the threshold and did push.
+    ///
+    /// A flat face landing bounces on both corners at once: solved one corner at a time,
+    /// the first would tip the body and the second bounce less.
     fn restitution(&mut self, bounce_below: f64) {
-        for p in self.points.iter_mut() {
-            if p.restitution == 0.0
-                || p.relative_velocity > -bounce_below
-                || p.max_normal_impulse == 0.0
-            {
+        let bounces = |p: &PointConstraint| {
+            p.restitution != 0.0
+                && p.relative_velocity <= -bounce_below
+                && p.max_normal_impulse != 0.0
+        };
+        let mut i = 0;
+        while i < self.points.len() {
+            let paired = self.points[i].pair_coupling.is_some();
+            if paired && bounces(&self.points[i]) && bounces(&self.points[i + 1]) {
+                let (first, second) = self.points.split_at_mut(i + 1);
+                let (p, q) = (&mut first[i], &mut second[0]);
+                let target = |p: &PointConstraint| -p.restitution * p.relative_velocity;
+                let targets = (target(p), target(q));
+                let velocities = (
+                    normal_velocity(&self.bodies, p),
+                    normal_velocity(&self.bodies, q),
+                );
+                solve_normal_pair(&mut self.bodies, (p, q), velocities, targets, (1.0, 0.0));
+                i += 2;
                 continue;
             }
-            let (a, b) = (&self.bodies[p.a as usize], &self.bodies[p.b as usize]);
-            let ra = rotate_delta(a.dq, p.r_a);
-            let rb = rotate_delta(b.dq, p.r_b);
-            let dv = (a.v + cross_scalar(a.w, ra)) - (b.v + cross_scalar(b.w, rb));
-            let vn = dv.dot(&p.normal);
-            let impulse = -p.normal_mass * (vn + p.restitution * p.relative_velocity);
-            let total = (p.normal_impulse + impulse).max(0.0);
-            let delta = total - p.normal_impulse;
-            p.normal_impulse = total;
-            Self::apply(&mut self.bodies, p.a, p.b, ra, rb, p.normal * delta);
+            let stride = if paired { 2 } else { 1 };
+            for p in &mut self.points[i..i + stride] {
+                if bounces(p) {
+                    let vn = normal_velocity(&self.bodies, p);
+                    let impulse = -p.normal_mass * (vn + p.restitution * p.relative_velocity);
+                    apply_normal(&mut self.bodies, p, p.normal_impulse + impulse);
+                }
+            }
+            i += stride;
         }
     }
 
@@ -377,14 +530,76 @@ impl SoftStepSolver {
         self.next_memory.sort_unstable_by_key(|x| x.0);
         std::mem::swap(&mut self.memory, &mut self.next_memory);
         self.joint_memory.clear();
-        for (j, c) in self.joints.iter().zip(joints.iter_mut()) {
+        for j in &self.joints {
             self.joint_memory.push((j.slot, j.impulse, j.motor_impulse));
-            if let Some(m) = c.motor.as_mut() {
+            if let Some(m) = joints[j.input as usize].motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
                 m.step_impulse = j.motor_step_total;
             }
         }
         self.joint_memory.sort_unstable_by_key(|x| x.0);
+    }
+}
+
+/// A contact point's normal velocity at its fixed anchors (A relative to B).
+///
+/// Until the point first pushes, this also records the fastest approach: the bounce at the
+/// end of the step reverses the speed of the impact, which gravity may have raised since
+/// the step began.
+/// A speculative point closes its remaining gap within the substep without speeding up
+/// over it; the impact speed adds what the closing acceleration would have given there.
+fn approach(bodies: &[SoftBody], p: &mut PointConstraint, separation: f64) -> f64 {
+    let vn = normal_velocity(bodies, p);
+    if p.max_normal_impulse == 0.0 && vn < 0.0 {
+        let gained = 2.0 * p.closing_acceleration * separation.max(0.0);
+        let impact = -(vn * vn + gained.max(0.0)).sqrt();
+        p.relative_velocity = p.relative_velocity.min(impact);
+    }
+    vn
+}
+
+fn normal_velocity(bodies: &[SoftBody], p: &PointConstraint) -> f64 {
+    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+    ((a.v + cross_scalar(a.w, p.r_a)) - (b.v + cross_scalar(b.w, p.r_b))).dot(&p.normal)
+}
+
+/// Sets a point's accumulated normal impulse to `total` (clamped at 0), applying the
+/// difference.
+fn apply_normal(bodies: &mut [SoftBody], p: &mut PointConstraint, total: f64) {
+    let total = total.max(0.0);
+    let delta = total - p.normal_impulse;
+    p.normal_impulse = total;
+    p.max_normal_impulse = p.max_normal_impulse.max(delta);
+    SoftStepSolver::apply(bodies, p.a, p.b, p.r_a, p.r_b, p.normal * delta);
+}
+
+/// The velocity a point's normal row aims at (minus bias) and its softness: speculative
+/// (closing the gap and no more), soft with bias, or rigid in the relax pass.
+fn normal_target(
+    bodies: &[SoftBody],
+    p: &PointConstraint,
+    h: f64,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) -> (f64, (f64, f64), f64) {
+    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+    // Current separation: how the anchors moved along the normal since the start. The
+    // impulse acts at the anchors fixed for the step (as warm starting applies it), so
+    // that every substep pushes through the same lever.
+    let moved =
+        (a.dp + rotate_delta(a.dq, p.r_a) - p.r_a) - (b.dp + rotate_delta(b.dq, p.r_b) - p.r_b);
+    let separation = moved.dot(&p.normal) + p.base_separation;
+    if separation > 0.0 {
+        (-separation / h, (1.0, 0.0), separation)
+    } else if use_bias {
+        (
+            -(soft.bias_rate * separation).max(-max_push),
+            (soft.mass_scale, soft.impulse_scale),
+            separation,
+        )
+    } else {
+        (0.0, (1.0, 0.0), separation)
     }
 }
 
@@ -396,50 +611,90 @@ fn solve_point(
     max_push: f64,
     use_bias: bool,
 ) {
-    let (a, b) = (bodies[p.a as usize], bodies[p.b as usize]);
-    let ra = rotate_delta(a.dq, p.r_a);
-    let rb = rotate_delta(b.dq, p.r_b);
-    // Current separation: how the anchors moved along the normal since the start.
-    let moved = (a.dp + ra - p.r_a) - (b.dp + rb - p.r_b);
-    let separation = moved.dot(&p.normal) + p.base_separation;
-    let (bias, mass_scale, impulse_scale) = if separation > 0.0 {
-        (separation / h, 1.0, 0.0) // speculative: may close the gap, no more
-    } else if use_bias {
-        (
-            (soft.bias_rate * separation).max(-max_push),
-            soft.mass_scale,
-            soft.impulse_scale,
-        )
-    } else {
-        (0.0, 1.0, 0.0)
-    };
-    let dv = (a.v + cross_scalar(a.w, ra)) - (b.v + cross_scalar(b.w, rb));
-    let vn = dv.dot(&p.normal);
-    let impulse = -p.normal_mass * mass_scale * (vn + bias) - impulse_scale * p.normal_impulse;
-    let total = (p.normal_impulse + impulse).max(0.0);
-    let delta = total - p.normal_impulse;
-    p.normal_impulse = total;
-    p.max_normal_impulse = p.max_normal_impulse.max(delta);
-    SoftStepSolver::apply(bodies, p.a, p.b, ra, rb, p.normal * delta);
+    let (target, (mass_scale, impulse_scale), separation) =
+        normal_target(bodies, p, h, soft, max_push, use_bias);
+    let vn = approach(bodies, p, separation);
+    let impulse = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
+    apply_normal(bodies, p, p.normal_impulse + impulse);
+    solve_friction(bodies, p);
+}
 
+fn solve_friction(bodies: &mut [SoftBody], p: &mut PointConstraint) {
     let (a, b) = (bodies[p.a as usize], bodies[p.b as usize]);
     let t = perp(p.normal);
-    let dv = (a.v + cross_scalar(a.w, ra)) - (b.v + cross_scalar(b.w, rb));
+    let dv = (a.v + cross_scalar(a.w, p.r_a)) - (b.v + cross_scalar(b.w, p.r_b));
     let vt = dv.dot(&t);
     let limit = p.friction * p.normal_impulse;
     let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
-    SoftStepSolver::apply(bodies, p.a, p.b, ra, rb, t * delta);
+    SoftStepSolver::apply(bodies, p.a, p.b, p.r_a, p.r_b, t * delta);
 }
 
-fn solve_joint(
+/// Two points of one manifold: normals together (when both rows have the same softness),
+/// then friction point by point.
+fn solve_pair(
     bodies: &mut [SoftBody],
-    j: &mut SoftJoint,
+    (p, q): (&mut PointConstraint, &mut PointConstraint),
     h: f64,
     soft: &Softness,
+    max_push: f64,
     use_bias: bool,
 ) {
+    let (tp, sp, dp) = normal_target(bodies, p, h, soft, max_push, use_bias);
+    let (tq, sq, dq) = normal_target(bodies, q, h, soft, max_push, use_bias);
+    if sp == sq {
+        let (v1, v2) = (approach(bodies, p, dp), approach(bodies, q, dq));
+        solve_normal_pair(bodies, (p, q), (v1, v2), (tp, tq), sp);
+    } else {
+        for (x, target, (mass_scale, impulse_scale), separation) in
+            [(&mut *p, tp, sp, dp), (&mut *q, tq, sq, dq)]
+        {
+            let vn = approach(bodies, x, separation);
+            let impulse =
+                -x.normal_mass * mass_scale * (vn - target) - impulse_scale * x.normal_impulse;
+            apply_normal(bodies, x, x.normal_impulse + impulse);
+        }
+    }
+    solve_friction(bodies, p);
+    solve_friction(bodies, q);
+}
+
+/// The 2 × 2 normal block as a small LCP, solved by trying its four active sets: find
+/// totals x ≥ 0 with w = (v_n − target) + K (x − (1 − s)·x₀) / m_s ≥ 0 and x·w = 0 (m_s, s
+/// the softness scales, x₀ the accumulated impulses; rigid rows have m_s = 1, s = 0).
+fn solve_normal_pair(
+    bodies: &mut [SoftBody],
+    (p, q): (&mut PointConstraint, &mut PointConstraint),
+    (v1, v2): (f64, f64),
+    (tp, tq): (f64, f64),
+    (mass_scale, impulse_scale): (f64, f64),
+) {
+    let k12 = p.pair_coupling.expect("paired points");
+    let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
+    let (x1, x2) = (p.normal_impulse, q.normal_impulse);
+    let keep = 1.0 - impulse_scale;
+    // A = K / m_s; b = v − target − A·keep·x₀.
+    let (a11, a12, a22) = (k11 / mass_scale, k12 / mass_scale, k22 / mass_scale);
+    let b1 = v1 - tp - keep * (a11 * x1 + a12 * x2);
+    let b2 = v2 - tq - keep * (a12 * x1 + a22 * x2);
+    let det = a11 * a22 - a12 * a12;
+    let both = ((a12 * b2 - a22 * b1) / det, (a12 * b1 - a11 * b2) / det);
+    let totals = if both.0 >= 0.0 && both.1 >= 0.0 {
+        both
+    } else if -b1 / a11 >= 0.0 && a12 * (-b1 / a11) + b2 >= 0.0 {
+        (-b1 / a11, 0.0)
+    } else if -b2 / a22 >= 0.0 && a12 * (-b2 / a22) + b1 >= 0.0 {
+        (0.0, -b2 / a22)
+    } else {
+        (0.0, 0.0) // b ≥ 0 is the only case left for a positive definite A
+    };
+    apply_normal(bodies, p, totals.0);
+    apply_normal(bodies, q, totals.1);
+}
+
+/// A joint motor: the relative spin driven towards its target, within ±max torque·h.
+fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
     if let Some((target, max_torque)) = j.motor {
         let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
         let k = a.inv_inertia + b.inv_inertia;
@@ -452,16 +707,127 @@ fn solve_joint(
             bodies[j.b as usize].w -= b.inv_inertia * delta;
         }
     }
+}
+
+/// A pin's current arms, its anchors' relative velocity plus the soft bias towards a
+/// closed gap, and the softness scales for this pass.
+fn pin_target(
+    bodies: &[SoftBody],
+    j: &SoftJoint,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) -> ((Vec2, Vec2), Vec2, f64, f64) {
     let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
     let ra = rotate_delta(a.dq, j.r_a);
     let rb = rotate_delta(b.dq, j.r_b);
     let dv = (a.v + cross_scalar(a.w, ra)) - (b.v + cross_scalar(b.w, rb));
-    let (bias, mass_scale, impulse_scale) = if use_bias {
-        let gap = (a.dp + ra - j.r_a) - (b.dp + rb - j.r_b) + j.base_gap;
-        (gap * soft.bias_rate, soft.mass_scale, soft.impulse_scale)
+    if !use_bias {
+        return ((ra, rb), dv, 1.0, 0.0);
+    }
+    let gap = (a.dp + ra - j.r_a) - (b.dp + rb - j.r_b) + j.base_gap;
+    let bias = gap * soft.bias_rate;
+    let speed = bias.norm();
+    let bias = if speed > max_push {
+        bias * (max_push / speed)
     } else {
-        (Vec2::zeros(), 1.0, 0.0)
+        bias
     };
+    ((ra, rb), dv + bias, soft.mass_scale, soft.impulse_scale)
+}
+
+impl JointBlock {
+    /// Solves one island's pins together: K ψ = −(Δv + bias) over all of them, then each
+    /// impulse softened as a lone pin's would be. False if K is not positive definite
+    /// (redundant pins), leaving the bodies untouched.
+    fn solve(
+        &mut self,
+        bodies: &mut [SoftBody],
+        island: &mut [SoftJoint],
+        soft: &Softness,
+        max_push: f64,
+        use_bias: bool,
+    ) -> bool {
+        let m = island.len();
+        self.arms.clear();
+        // Buffers keep their allocation from pass to pass.
+        let mut k = std::mem::replace(&mut self.k, DMatrix::zeros(0, 0));
+        k.resize_mut(2 * m, 2 * m, 0.0);
+        k.fill(0.0);
+        self.rhs.resize_vertically_mut(2 * m, 0.0);
+        let (mut mass_scale, mut impulse_scale) = (1.0, 0.0);
+        for (p, j) in island.iter().enumerate() {
+            let (arms, target, ms, is) = pin_target(bodies, j, soft, max_push, use_bias);
+            self.arms.push(arms);
+            (mass_scale, impulse_scale) = (ms, is);
+            self.rhs[2 * p] = -target.x;
+            self.rhs[2 * p + 1] = -target.y;
+        }
+        for p in 0..m {
+            for q in p..m {
+                let block = coupling(bodies, &island[p], self.arms[p], &island[q], self.arms[q]);
+                for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                    k[(2 * p + r, 2 * q + c)] = block[r][c];
+                    k[(2 * q + c, 2 * p + r)] = block[r][c];
+                }
+            }
+        }
+        let Some(cholesky) = k.cholesky() else {
+            return false;
+        };
+        cholesky.solve_mut(&mut self.rhs);
+        self.k = cholesky.unpack_dirty();
+        let psi = &self.rhs;
+        for (p, j) in island.iter_mut().enumerate() {
+            let impulse =
+                Vec2::new(psi[2 * p], psi[2 * p + 1]) * mass_scale - j.impulse * impulse_scale;
+            j.impulse += impulse;
+            let (ra, rb) = self.arms[p];
+            SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);
+        }
+        true
+    }
+}
+
+/// The velocity change at pin `p`'s anchors per unit impulse at pin `q`'s: one 2×2 block
+/// of J M⁻¹ Jᵀ, summed over the bodies they share (+ on A, − on B).
+fn coupling(
+    bodies: &[SoftBody],
+    p: &SoftJoint,
+    (pa, pb): (Vec2, Vec2),
+    q: &SoftJoint,
+    (qa, qb): (Vec2, Vec2),
+) -> [[f64; 2]; 2] {
+    let mut k = [[0.0; 2]; 2];
+    for (bp, sp, rp) in [(p.a, 1.0, pa), (p.b, -1.0, pb)] {
+        for (bq, sq, rq) in [(q.a, 1.0, qa), (q.b, -1.0, qb)] {
+            let body = &bodies[bp as usize];
+            if bp != bq || (body.inv_mass == 0.0 && body.inv_inertia == 0.0) {
+                continue;
+            }
+            let (m, i) = (body.inv_mass, body.inv_inertia);
+            let s = sp * sq;
+            // Δv at rp = m·P + i·(rq × P)·perp(rp), P a unit impulse along x, then y.
+            k[0][0] += s * (m + i * rp.y * rq.y);
+            k[0][1] += s * (-i * rp.y * rq.x);
+            k[1][0] += s * (-i * rp.x * rq.y);
+            k[1][1] += s * (m + i * rp.x * rq.x);
+        }
+    }
+    k
+}
+
+/// One pin alone (islands too big for the block solve).
+fn solve_joint(
+    bodies: &mut [SoftBody],
+    j: &mut SoftJoint,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) {
+    let ((ra, rb), target, mass_scale, impulse_scale) =
+        pin_target(bodies, j, soft, max_push, use_bias);
+    let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
     let m = a.inv_mass + b.inv_mass;
     let (ia, ib) = (a.inv_inertia, b.inv_inertia);
     let k11 = m + ia * ra.y * ra.y + ib * rb.y * rb.y;
@@ -471,7 +837,7 @@ fn solve_joint(
     if det <= 0.0 {
         return;
     }
-    let rhs = dv + bias;
+    let rhs = target;
     let solved = Vec2::new(k22 * rhs.x - k12 * rhs.y, k11 * rhs.y - k12 * rhs.x) / det;
     let impulse = -solved * mass_scale - j.impulse * impulse_scale;
     j.impulse += impulse;
