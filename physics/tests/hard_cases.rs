@@ -28,31 +28,34 @@ fn finite(world: &World) -> bool {
 
 #[test]
 fn a_small_fast_body_never_passes_through_a_thin_wall() {
-    fast_bodies_against_a_thin_wall(&[ContactSolver::Exact, ContactSolver::Thesis]);
+    fast_bodies_against_a_thin_wall(&SOLVERS, true);
 }
 
 #[test]
-#[ignore = "known failure, open in issue 9: the soft step lets a 1000 m/s body through"]
-fn the_soft_step_stops_a_small_fast_body_at_a_thin_wall() {
-    fast_bodies_against_a_thin_wall(&[ContactSolver::Soft]);
+fn without_continuous_collision_the_soft_step_lets_a_spinning_body_through() {
+    // The check above is not vacuous: the soft step alone (contacts found once, at the
+    // step's start) lets one of these through.
+    let through = std::panic::catch_unwind(|| {
+        fast_bodies_against_a_thin_wall(&[ContactSolver::Soft], false);
+    });
+    assert!(
+        through.is_err(),
+        "expected a tunnelling body without time of impact"
+    );
 }
 
-fn fast_bodies_against_a_thin_wall(solvers: &[ContactSolver]) {
+fn fast_bodies_against_a_thin_wall(solvers: &[ContactSolver], continuous: bool) {
     // A 0.1 box against a wall 0.02 thick, at up to 1000 m/s: 170 of its widths per step.
     // Speculative contacts see the wall as soon as it is within this step's reach. The
     // wall is tall enough that nothing can fly round its end in the 2 s.
     for &solver in solvers {
         for speed in [10.0, 50.0, 200.0, 1000.0] {
             for (angle, spin) in [(0.0, 0.0), (0.3, 0.0), (0.7, 40.0), (0.1, -300.0f64)] {
-                // The soft step finds contacts once per step at the start pose; a body
-                // turning more than a radian per substep slips past them (known, left).
-                if solver == ContactSolver::Soft && spin.abs() > 100.0 {
-                    continue;
-                }
                 for heading in [0.0f64, 0.5, -0.9] {
                     let mut w = World::new(Vec2::new(0.0, 0.0));
                     w.settings.contact_solver = solver;
                     w.settings.length_scale = 0.1;
+                    w.settings.continuous = continuous;
                     let wall = ConvexPolygon::rectangle(0.02, 5000.0).unwrap();
                     w.add_body(BodyDef::new(wall, 0.0).at(Vec2::zeros(), 0.0))
                         .unwrap();
@@ -89,7 +92,7 @@ fn extreme_but_legal_input_simulates_sanely() {
 }
 
 #[test]
-#[ignore = "known failure, open in issue 9: under the soft step a 1 mm box falls through the floor"]
+#[ignore = "known failure, open: under the soft step a box 1e6 times heavier crushes the one under it by a third of its size"]
 fn the_soft_step_handles_extreme_but_legal_input() {
     extreme_input(&[ContactSolver::Soft]);
 }

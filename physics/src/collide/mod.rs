@@ -2,6 +2,7 @@
 
 mod broad;
 mod sat;
+pub mod toi;
 
 pub use broad::SweepAndPrune;
 pub use sat::collide_polygons;
@@ -44,8 +45,13 @@ pub struct WorldPolygon {
 impl WorldPolygon {
     /// Refills `self` from `body` without reallocating when the size is unchanged.
     pub fn update(&mut self, body: &Body) {
+        self.set_vertices(body.world_vertices());
+    }
+
+    /// Refills `self` from world vertices in the positive order.
+    pub fn set_vertices(&mut self, vertices: impl Iterator<Item = Vec2>) {
         self.vertices.clear();
-        self.vertices.extend(body.world_vertices());
+        self.vertices.extend(vertices);
         self.normals.clear();
         let n = self.vertices.len();
         for i in 0..n {

@@ -65,7 +65,7 @@ pub fn collide_polygons(
 
 /// The edge of `p` whose outward normal separates `q` most, and that separation
 /// (negative = overlap). Earlier edges win ties.
-fn max_separation(p: &WorldPolygon, q: &WorldPolygon) -> (usize, f64) {
+pub(super) fn max_separation(p: &WorldPolygon, q: &WorldPolygon) -> (usize, f64) {
     let mut best = (0, f64::NEG_INFINITY);
     for (i, (n, v)) in p.normals.iter().zip(&p.vertices).enumerate() {
         let separation = q
