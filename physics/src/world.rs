@@ -39,8 +39,8 @@ pub struct StepSettings {
     pub dense_row_limit: usize,
     /// Whether islands at rest go to sleep (see `World::step`).
     pub sleeping: bool,
-    /// Whether a body moving more than half its inner radius in a step is stopped at its
-    /// time of impact with static bodies (see `World::step`).
+    /// Whether a body that ends a step through or deep in a static body is put back to its
+    /// time of impact (see `World::step`).
     pub continuous: bool,
 }
 
@@ -385,8 +385,9 @@ impl World {
     /// motor running, goes to sleep: it is skipped until an awake body comes within reach
     /// of one of its bodies, a motor on it switches on, or `wake_body` is called.
     ///
-    /// With `settings.continuous`, a body that moved more than half its inner radius this
-    /// step and ended up through a static body, or deep in it, is put back along its path to
+    /// With `settings.continuous`, a body that moved more than half its inner radius (or
+    /// the contact margin) this step and ended up through a static body, or deeper than
+    /// twice the slop in it, is put back along its path to
     /// where it first came within the slop of it (its time of impact), keeping its velocity
     /// for the next step's contacts to answer. Speculative contacts stop most fast bodies
     /// already; this catches what they miss (a spinning body, the soft step's contacts
@@ -423,6 +424,7 @@ impl World {
     /// Continuous collision: see `step`.
     fn stop_at_impact(&mut self) {
         let slop = self.settings.slop();
+        let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
         for i in 0..self.bodies.len() {
             let Some(body) = self.bodies[i].as_ref() else {
@@ -438,7 +440,9 @@ impl World {
             let radius = body.bounding_radius();
             let motion =
                 (sweep.end.0 - sweep.start.0).norm() + (sweep.end.1 - sweep.start.1).abs() * radius;
-            if motion <= 0.5 * inner_radius(body.local_vertices()) {
+            // Fast bodies, and bodies an impact sent further than the contact margin (their
+            // contacts were found before the solve, for the motion they had then).
+            if motion <= (0.5 * inner_radius(body.local_vertices())).min(margin) {
                 continue;
             }
             let local = body.local_vertices();
@@ -736,11 +740,17 @@ impl World {
             let pair = self.contacts[k..]
                 .iter()
                 .take_while(|p| (p.body_a, p.body_b) == (c.body_a, c.body_b));
-            let gap = pair
-                .filter(|p| p.depth < 0.0 && p.normal_impulse > 0.0 && p.bounces(dt, bounce_below))
-                .map(|p| (1.0 - p.restitution * p.restitution) * -p.depth)
-                .fold(0.0, f64::max);
-            if gap == 0.0 {
+            let (mut gap, mut room) = (0.0, f64::INFINITY);
+            for p in pair {
+                if p.depth < 0.0 && p.normal_impulse > 0.0 && p.bounces(dt, bounce_below) {
+                    gap = f64::max(gap, (1.0 - p.restitution * p.restitution) * -p.depth);
+                }
+                // The shift may not push any of the pair's other points in: a body
+                // pivoting on one corner that bounces on the other must stay out at both.
+                room = room.min(-p.depth);
+            }
+            let gap = gap.min(room);
+            if gap <= 0.0 {
                 continue;
             }
             let is_fixed = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_fixed);
