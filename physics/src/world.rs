@@ -166,7 +166,7 @@ const SLEEP_AFTER: f64 = 0.5;
 struct Scratch {
     sleep_union: UnionFind,
     wake_labels: Vec<u32>,
-    asleep: Vec<usize>,
+    wake_broad_phase: SweepAndPrune,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
     boxes: Vec<Option<Aabb>>,
@@ -511,28 +511,53 @@ impl World {
     }
 
     /// Wakes sleeping islands that an awake body can reach this step, and those with a
-    /// motor switching on.
+    /// motor switching on. Candidates come from a sweep and prune over the bodies' bounding
+    /// circles (each awake one grown by its reach), so the cost follows the bodies near
+    /// each other, not awake × asleep.
     fn wake_where_needed(&mut self, dt: f64) {
         let margin = self.settings.contact_margin();
         let mut wake = std::mem::take(&mut self.scratch.wake_labels);
         wake.clear();
-        let mut asleep = std::mem::take(&mut self.scratch.asleep);
-        asleep.clear();
-        asleep.extend(
-            (0..self.bodies.len()).filter(|&i| self.bodies[i].as_ref().is_some_and(|b| b.asleep)),
-        );
-        for awake in self.bodies.iter().flatten().filter(|b| !b.is_fixed()) {
-            let reach = (awake.velocity.norm()
-                + awake.angular_velocity.abs() * awake.bounding_radius()
-                + self.gravity.norm() * dt)
-                * dt;
-            for &i in &asleep {
-                let b = self.bodies[i].as_ref().expect("listed as asleep");
-                let apart = (b.position - awake.position).norm()
-                    - b.bounding_radius()
-                    - awake.bounding_radius();
-                if apart <= margin + reach {
-                    wake.push(self.sleep_labels[i]);
+        let some_asleep = self.bodies.iter().flatten().any(|b| b.asleep);
+        let some_awake = self.bodies.iter().flatten().any(|b| !b.is_fixed());
+        if some_asleep && some_awake {
+            let reach = |b: &Body| {
+                (b.velocity.norm()
+                    + b.angular_velocity.abs() * b.bounding_radius()
+                    + self.gravity.norm() * dt)
+                    * dt
+            };
+            let s = &mut self.scratch;
+            s.boxes.clear();
+            s.reach.clear();
+            for body in &self.bodies {
+                let r = body
+                    .as_ref()
+                    .map_or(0.0, |b| if b.asleep { 0.0 } else { reach(b) });
+                s.reach.push(r);
+                s.boxes
+                    .push(body.as_ref().filter(|b| !b.is_static()).map(|b| {
+                        let half = b.bounding_radius() + r + 0.5 * margin;
+                        Aabb {
+                            min: b.position - Vec2::new(half, half),
+                            max: b.position + Vec2::new(half, half),
+                        }
+                    }));
+            }
+            let bodies = &self.bodies;
+            let asleep = |i: usize| bodies[i].as_ref().is_some_and(|b| b.asleep);
+            s.wake_broad_phase
+                .pairs(&s.boxes, |i, j| asleep(i) != asleep(j), &mut s.pairs);
+            for &(i, j) in &s.pairs {
+                let (sleeper, awake) = if asleep(i as usize) { (i, j) } else { (j, i) };
+                let (b, a) = (
+                    bodies[sleeper as usize].as_ref().expect("boxed"),
+                    bodies[awake as usize].as_ref().expect("boxed"),
+                );
+                let apart =
+                    (b.position - a.position).norm() - b.bounding_radius() - a.bounding_radius();
+                if apart <= margin + s.reach[awake as usize] {
+                    wake.push(self.sleep_labels[sleeper as usize]);
                 }
             }
         }
@@ -557,7 +582,6 @@ impl World {
             self.wake_island(label);
         }
         self.scratch.wake_labels = wake;
-        self.scratch.asleep = asleep;
     }
 
     /// Times how long each awake body has been still, and puts to sleep the islands whose
