@@ -189,6 +189,8 @@ struct Scratch {
     mover: WorldPolygon,
     obstacle: WorldPolygon,
     toi_scratch: WorldPolygon,
+    /// Static bodies' outlines and bounds, for continuous collision.
+    obstacles: Vec<(WorldPolygon, Aabb)>,
 }
 
 impl World {
@@ -426,11 +428,23 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
+        // The static bodies' outlines and bounds, once per step.
+        let mut obstacles = std::mem::take(&mut s.obstacles);
+        let mut count = 0;
+        for obstacle in self.bodies.iter().flatten().filter(|o| o.is_static()) {
+            if obstacles.len() == count {
+                obstacles.push((WorldPolygon::default(), Aabb::default()));
+            }
+            let (polygon, bounds) = &mut obstacles[count];
+            polygon.update(obstacle);
+            *bounds = polygon.aabb();
+            count += 1;
+        }
         for i in 0..self.bodies.len() {
             let Some(body) = self.bodies[i].as_ref() else {
                 continue;
             };
-            if body.is_fixed() {
+            if body.is_fixed() || count == 0 {
                 continue;
             }
             let sweep = Sweep {
@@ -445,37 +459,44 @@ impl World {
             if motion <= (0.5 * inner_radius(body.local_vertices())).min(margin) {
                 continue;
             }
+            let swept = Aabb {
+                min: sweep.start.0.inf(&sweep.end.0),
+                max: sweep.start.0.sup(&sweep.end.0),
+            }
+            .grown(radius + slop);
             let local = body.local_vertices();
             place(&mut s.mover, local, sweep.end);
+            place(&mut s.toi_scratch, local, sweep.start);
             let mut first: Option<f64> = None;
-            for obstacle in self.bodies.iter().flatten().filter(|o| o.is_static()) {
-                // Only obstacles the swept circle can reach.
-                let path = sweep.end.0 - sweep.start.0;
-                let along = (obstacle.position - sweep.start.0).dot(&path) / path.norm_squared();
-                let closest = sweep.start.0 + path * along.clamp(0.0, 1.0);
-                let reach = radius + obstacle.bounding_radius() + slop;
-                if path.norm_squared() > 0.0 && (obstacle.position - closest).norm() > reach
-                    || path.norm_squared() == 0.0
-                        && (obstacle.position - sweep.start.0).norm() > reach
-                {
+            for (polygon, bounds) in &obstacles[..count] {
+                if !swept.overlaps(bounds) {
                     continue;
                 }
-                s.obstacle.update(obstacle);
                 // Ending in contact (within the solver's slop either way) is the contact
                 // solver's business: a landing, a body sliding along a floor.
-                let end_gap = separation(&s.mover, &s.obstacle);
+                let end_gap = separation(&s.mover, polygon);
                 if (-2.0 * slop..=slop).contains(&end_gap) {
                     continue;
                 }
+                // Apart at both ends, and too far apart for the motion to have touched in
+                // between (the gap shrinks no faster than `motion` per step).
+                if end_gap > slop {
+                    let start_gap = separation(&s.toi_scratch, polygon);
+                    if start_gap + end_gap > motion + 2.0 * slop {
+                        continue;
+                    }
+                }
+                let mut scratch = std::mem::take(&mut s.obstacle);
                 let hit = time_of_impact(
                     local,
                     radius,
                     &sweep,
-                    &s.obstacle,
+                    polygon,
                     slop,
                     0.25 * slop,
-                    &mut s.toi_scratch,
+                    &mut scratch,
                 );
+                s.obstacle = scratch;
                 if let Some(t) = hit {
                     first = Some(first.map_or(t, |f: f64| f.min(t)));
                 }
@@ -487,6 +508,7 @@ impl World {
                 body.angle = angle;
             }
         }
+        s.obstacles = obstacles;
     }
 
     /// Wakes `handle` and everything asleep in its island.

@@ -11,7 +11,7 @@ use crate::body::{Body, BodyHandle};
 use crate::math::Vec2;
 
 /// An axis-aligned bounding box.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Aabb {
     pub min: Vec2,
     pub max: Vec2,
