@@ -1,8 +1,9 @@
-//! Times `pe` (contact solvers `exact` and `soft`) against rapier2d on scenes with known
-//! answers, and writes the results as Markdown to docs/bench/results.md.
+//! Times `pe` (contact solvers `exact` and `soft`) against rapier2d and Box2D v3 on scenes
+//! with known answers, and writes the results as Markdown to docs/bench/results.md.
 //!
 //! Run with `cargo run --release` inside bench/.
 
+mod box2d_scenes;
 mod harness;
 mod pe_scenes;
 mod rapier_scenes;
@@ -27,8 +28,11 @@ impl Outcome {
     }
 }
 
-/// The pe solvers compared; rapier2d is the reference for the time ratios.
+/// The pe solvers compared; the peers are the references for the time ratios.
 const PE_SOLVERS: [ContactSolver; 2] = [ContactSolver::Exact, ContactSolver::Soft];
+
+/// The peer engines, in the order of `Row::peers`.
+const PEERS: [&str; 2] = ["rapier2d", "Box2D v3"];
 
 /// One scene in every engine.
 struct Row {
@@ -36,16 +40,18 @@ struct Row {
     known: String,
     /// In the order of `PE_SOLVERS`.
     pe: Vec<Outcome>,
-    rapier: Outcome,
+    /// In the order of `PEERS`.
+    peers: Vec<Outcome>,
 }
 
-/// Runs one scene in each pe solver and in rapier2d, reporting progress on stderr (the
+/// Runs one scene in each pe solver and in each peer, reporting progress on stderr (the
 /// whole benchmark takes a few minutes).
 fn run_row(
     scene: &str,
     known: String,
     pe_run: impl Fn(ContactSolver) -> Outcome,
     rapier_run: impl Fn() -> Outcome,
+    box2d_run: impl Fn() -> Outcome,
 ) -> Row {
     let started = Instant::now();
     eprint!("{scene}:");
@@ -58,6 +64,8 @@ fn run_row(
         .collect();
     eprint!(" rapier2d…");
     let rapier = rapier_run();
+    eprint!(" Box2D…");
+    let box2d = box2d_run();
     eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
     for o in &pe {
         if o.timing.cut_short() {
@@ -71,7 +79,7 @@ fn run_row(
         scene: scene.to_string(),
         known,
         pe,
-        rapier,
+        peers: vec![rapier, box2d],
     }
 }
 
@@ -85,6 +93,7 @@ fn main() {
             "stands: drift 0, 0 fallen".into(),
             |s| pe_scenes::pyramid(s, spec),
             || rapier_scenes::pyramid(spec),
+            || box2d_scenes::pyramid(spec),
         ));
     }
     for spec in &PENDULUMS {
@@ -93,6 +102,7 @@ fn main() {
             format!("T = {:.5} s, ΔE = 0", Pendulum::exact_period()),
             |s| pe_scenes::pendulum(s, spec),
             || rapier_scenes::pendulum(spec),
+            || box2d_scenes::pendulum(spec),
         ));
     }
     rows.push(run_row(
@@ -100,12 +110,14 @@ fn main() {
         "gap 0".into(),
         pe_scenes::heavy_chain,
         rapier_scenes::heavy_chain,
+        box2d_scenes::heavy_chain,
     ));
     rows.push(run_row(
         bounce::NAME,
         format!("peak e²·h = {} m", bounce::expected_peak()),
         pe_scenes::bounce,
         rapier_scenes::bounce,
+        box2d_scenes::bounce,
     ));
     let report = report(&rows, started.elapsed(), &load);
     println!("{report}");
@@ -153,8 +165,8 @@ fn metric_cell(o: &Outcome) -> String {
     }
 }
 
-fn ratio(pe: Duration, rapier: Duration) -> String {
-    let r = pe.as_secs_f64() / rapier.as_secs_f64();
+fn ratio(pe: Duration, peer: Duration) -> String {
+    let r = pe.as_secs_f64() / peer.as_secs_f64();
     if r < 100.0 {
         format!("{r:.2}")
     } else {
@@ -167,16 +179,20 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
     let mut md = String::new();
     let w = &mut md;
     // Writing to a String cannot fail.
-    let _ = writeln!(w, "# pe vs rapier2d\n");
+    let _ = writeln!(w, "# pe vs rapier2d and Box2D v3\n");
     let _ = writeln!(w, "- Machine: {}; load average at start: {load}", machine());
     let _ = writeln!(w, "- Date: {} (UTC)", today());
     let _ = writeln!(
         w,
         "- Engines: pe (this repository, f64) with contact solvers `{}`; rapier2d {} \
          (f32, default features, one thread), default `IntegrationParameters` except `dt`, \
-         every body with `can_sleep(false)`.",
+         every body with `can_sleep(false)`; Box2D v3 through boxdd {} (Box2D's C \
+         sources built by cc, f32, one thread), default world settings with {} substeps, \
+         sleeping off.",
         names.join("` and `"),
-        rapier_version()
+        rapier_version(),
+        locked_version("boxdd"),
+        box2d_scenes::SUBSTEPS
     );
     let _ = writeln!(
         w,
@@ -207,22 +223,27 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
         let _ = write!(header, " pe {n} |");
         rule.push_str("---:|");
     }
-    header.push_str(" rapier2d |");
-    rule.push_str("---:|");
-    for n in &names {
-        let _ = write!(header, " pe {n} ÷ rapier2d |");
+    for peer in PEERS {
+        let _ = write!(header, " {peer} |");
         rule.push_str("---:|");
+    }
+    for peer in PEERS {
+        for n in &names {
+            let _ = write!(header, " pe {n} ÷ {peer} |");
+            rule.push_str("---:|");
+        }
     }
     let _ = writeln!(w, "{header}\n{rule}");
     for r in rows {
-        let t = &r.rapier.timing;
+        let t = &r.peers[0].timing;
         let _ = write!(w, "| {} | {} ({}) |", r.scene, t.planned, t.timed_steps);
-        for o in &r.pe {
+        for o in r.pe.iter().chain(&r.peers) {
             let _ = write!(w, " {} |", time_cell(&o.timing));
         }
-        let _ = write!(w, " {} |", time_cell(t));
-        for o in &r.pe {
-            let _ = write!(w, " {} |", ratio(o.timing.median, t.median));
+        for peer in &r.peers {
+            for o in &r.pe {
+                let _ = write!(w, " {} |", ratio(o.timing.median, peer.timing.median));
+            }
         }
         let _ = writeln!(w);
     }
@@ -234,15 +255,17 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
         let _ = write!(header, " pe {n} |");
         rule.push_str("---|");
     }
-    header.push_str(" rapier2d |");
-    rule.push_str("---|");
+    for peer in PEERS {
+        let _ = write!(header, " {peer} |");
+        rule.push_str("---|");
+    }
     let _ = writeln!(w, "{header}\n{rule}");
     for r in rows {
         let _ = write!(w, "| {} | {} |", r.scene, r.known);
-        for o in &r.pe {
+        for o in r.pe.iter().chain(&r.peers) {
             let _ = write!(w, " {} |", metric_cell(o));
         }
-        let _ = writeln!(w, " {} |", metric_cell(&r.rapier));
+        let _ = writeln!(w);
     }
     let _ = writeln!(
         w,
@@ -278,9 +301,15 @@ fn machine() -> String {
 
 /// The rapier2d version actually built, from this crate's lock file.
 fn rapier_version() -> &'static str {
+    locked_version("rapier2d")
+}
+
+/// A dependency's version as this crate's lock file records it.
+fn locked_version(name: &str) -> &'static str {
     let lock = include_str!("../Cargo.lock");
+    let wanted = format!("name = \"{name}\"");
     lock.split("[[package]]")
-        .find(|p| p.contains("name = \"rapier2d\""))
+        .find(|p| p.lines().any(|l| l.trim() == wanted))
         .and_then(|p| p.lines().find_map(|l| l.strip_prefix("version = ")))
         .map_or("(unknown version)", |v| v.trim_matches('"'))
 }

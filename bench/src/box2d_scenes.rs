@@ -1,0 +1,226 @@
+//! The scenes built in Box2D v3 (through the `boxdd` crate, which compiles Box2D's C
+//! sources). Box2D's y axis points up, as the scene's does; it works in f32, and results
+//! are widened to f64 for the shared trackers. Defaults throughout (4 substeps, contact
+//! hertz 30, joint softness from it), except sleeping, which is off on every body so
+//! that every body is simulated on every step, as in pe and rapier2d here.
+
+use crate::Outcome;
+use crate::harness::measure;
+use crate::scene::{
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
+    ReboundTracker, bounce, chain, worst,
+};
+use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
+
+/// Box2D's default substep count for `b2World_Step`.
+pub const SUBSTEPS: i32 = 4;
+
+fn point((x, y): (f64, f64)) -> Vec2 {
+    Vec2::new(x as f32, y as f32)
+}
+
+fn world() -> World {
+    let def = WorldDef::builder()
+        .gravity([0.0, -G as f32])
+        .enable_sleep(false)
+        .build();
+    World::new(def).expect("a valid world definition")
+}
+
+fn step(w: &mut World, h: f64) {
+    w.step(h as f32, SUBSTEPS);
+}
+
+/// A box of full size `w` × `h` on a new body; Box2D mixes friction by the geometric mean
+/// and restitution by the maximum.
+fn boxed(
+    world: &mut World,
+    body_type: BodyType,
+    centre: (f64, f64),
+    size: (f64, f64),
+    density: f64,
+    restitution: f64,
+) -> BodyId {
+    let def = BodyBuilder::new()
+        .body_type(body_type)
+        .position(point(centre))
+        .enable_sleep(false)
+        .build();
+    let body = world.create_body_id(def);
+    let material = SurfaceMaterial::default()
+        .with_friction(FRICTION as f32)
+        .with_restitution(restitution as f32);
+    let shape = ShapeDef::builder()
+        .material(material)
+        .density(density as f32)
+        .build();
+    let polygon = boxdd::shapes::box_polygon(0.5 * size.0 as f32, 0.5 * size.1 as f32);
+    world.create_polygon_shape_for(body, &shape, &polygon);
+    body
+}
+
+fn centre(world: &World, body: BodyId) -> (f64, f64) {
+    let p = world.body_position(body);
+    (f64::from(p.x), f64::from(p.y))
+}
+
+/// The static floor, top face at y = 0, restitution 0 (the pair takes the larger).
+fn floor(w: &mut World) {
+    boxed(w, BodyType::Static, (0.0, -0.5 * FLOOR.1), FLOOR, 0.0, 0.0);
+}
+
+pub fn pyramid(spec: &Pyramid) -> Outcome {
+    let mut w = world();
+    floor(&mut w);
+    let centres = spec.centres();
+    let boxes: Vec<BodyId> = centres
+        .iter()
+        .map(|&c| boxed(&mut w, BodyType::Dynamic, c, (BOX, BOX), 1.0, 0.0))
+        .collect();
+    let mut tracker = PyramidTracker::new(centres);
+    let timing = measure(
+        &mut w,
+        spec.steps,
+        |w| step(w, H),
+        |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+/// Kinetic plus gravitational energy of one body, from its mass properties.
+fn energy(world: &World, body: BodyId) -> f64 {
+    let mass = f64::from(world.body_mass(body));
+    let inertia = f64::from(world.body_rotational_inertia(body));
+    let v = world.body_linear_velocity(body);
+    let omega = f64::from(world.body_angular_velocity(body));
+    let (vx, vy) = (f64::from(v.x), f64::from(v.y));
+    let kinetic = 0.5 * mass * (vx * vx + vy * vy) + 0.5 * inertia * omega * omega;
+    kinetic + mass * G * f64::from(world.body_world_center_of_mass(body).y)
+}
+
+/// A pin between two bodies, remembered by its anchor in each body's frame so that its gap
+/// can be measured from the bodies' poses.
+struct Pin {
+    a: BodyId,
+    b: BodyId,
+    local_a: (f64, f64),
+    local_b: (f64, f64),
+}
+
+impl Pin {
+    fn new(world: &mut World, a: BodyId, b: BodyId, at: (f64, f64)) -> Self {
+        world.create_revolute_joint_world_id(a, b, point(at));
+        let local = |body: BodyId| {
+            let (cx, cy) = centre(world, body);
+            (at.0 - cx, at.1 - cy) // bodies start unrotated
+        };
+        Self {
+            a,
+            b,
+            local_a: local(a),
+            local_b: local(b),
+        }
+    }
+
+    fn gap(&self, world: &World) -> f64 {
+        let anchor = |body: BodyId, (lx, ly): (f64, f64)| {
+            let (cx, cy) = centre(world, body);
+            let r = world.body_rotation(body);
+            let (c, s) = (f64::from(r.cosine()), f64::from(r.sine()));
+            (cx + c * lx - s * ly, cy + s * lx + c * ly)
+        };
+        let (pa, pb) = (anchor(self.a, self.local_a), anchor(self.b, self.local_b));
+        (pa.0 - pb.0).hypot(pa.1 - pb.1)
+    }
+}
+
+/// A static body without shapes at the origin, to pin to.
+fn ground(world: &mut World) -> BodyId {
+    world.create_body_id(BodyBuilder::new().body_type(BodyType::Static).build())
+}
+
+pub fn pendulum(spec: &Pendulum) -> Outcome {
+    let mut w = world();
+    let pivot = ground(&mut w);
+    let bob = boxed(
+        &mut w,
+        BodyType::Dynamic,
+        Pendulum::bob_start(),
+        (BOB, BOB),
+        1.0,
+        0.0,
+    );
+    let pin = Pin::new(&mut w, pivot, bob, (0.0, 0.0));
+    let mut tracker = PeriodTracker::new(spec.h, centre(&w, bob).0, energy(&w, bob));
+    let h = spec.h;
+    let timing = measure(
+        &mut w,
+        spec.steps(),
+        |w| step(w, h),
+        |w, n| tracker.update(n, centre(w, bob).0, energy(w, bob), pin.gap(w)),
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn heavy_chain() -> Outcome {
+    let mut w = world();
+    let mut previous = ground(&mut w);
+    let mut pins = Vec::with_capacity(chain::LINKS + 1);
+    for i in 0..=chain::LINKS {
+        let body = if i < chain::LINKS {
+            let c = chain::link_centre(i);
+            boxed(
+                &mut w,
+                BodyType::Dynamic,
+                c,
+                chain::LINK,
+                chain::LINK_DENSITY,
+                0.0,
+            )
+        } else {
+            let size = (chain::END_SIZE, chain::END_SIZE);
+            let c = chain::end_centre();
+            boxed(&mut w, BodyType::Dynamic, c, size, chain::END_DENSITY, 0.0)
+        };
+        // Box2D's joints leave their bodies' collision off by default, as pe does.
+        pins.push(Pin::new(&mut w, previous, body, chain::pin(i)));
+        previous = body;
+    }
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(
+        &mut w,
+        chain::STEPS,
+        |w| step(w, H),
+        |w, _| {
+            for pin in &pins {
+                worst_gap = worst(worst_gap, pin.gap(w));
+            }
+        },
+    );
+    Outcome::new(timing, Metric::Chain { worst_gap })
+}
+
+pub fn bounce() -> Outcome {
+    let mut w = world();
+    floor(&mut w);
+    let half = 0.5 * bounce::SIZE;
+    let body = boxed(
+        &mut w,
+        BodyType::Dynamic,
+        (0.0, bounce::DROP + half),
+        (bounce::SIZE, bounce::SIZE),
+        1.0,
+        bounce::RESTITUTION,
+    );
+    let mut tracker = ReboundTracker::default();
+    let timing = measure(
+        &mut w,
+        bounce::STEPS,
+        |w| step(w, H),
+        |w, _| {
+            let v_up = f64::from(w.body_linear_velocity(body).y);
+            tracker.update(centre(w, body).1 - half, v_up);
+        },
+    );
+    Outcome::new(timing, tracker.finish())
+}
