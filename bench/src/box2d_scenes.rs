@@ -27,8 +27,8 @@ fn world() -> World {
     World::new(def).expect("a valid world definition")
 }
 
-fn step(w: &mut World, h: f64) {
-    w.step(h as f32, SUBSTEPS);
+fn step(w: &mut World, h: f64, substeps: i32) {
+    w.step(h as f32, substeps);
 }
 
 /// A box of full size `w` × `h` on a new body; Box2D mixes friction by the geometric mean
@@ -81,7 +81,7 @@ pub fn pyramid(spec: &Pyramid) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps,
-        |w| step(w, H),
+        |w| step(w, H, SUBSTEPS),
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
@@ -139,7 +139,7 @@ fn ground(world: &mut World) -> BodyId {
     world.create_body_id(BodyBuilder::new().body_type(BodyType::Static).build())
 }
 
-pub fn pendulum(spec: &Pendulum) -> Outcome {
+pub fn pendulum(spec: &Pendulum, substeps: i32) -> Outcome {
     let mut w = world();
     let pivot = ground(&mut w);
     let bob = boxed(
@@ -156,13 +156,13 @@ pub fn pendulum(spec: &Pendulum) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps(),
-        |w| step(w, h),
+        |w| step(w, h, substeps),
         |w, n| tracker.update(n, centre(w, bob).0, energy(w, bob), pin.gap(w)),
     );
     Outcome::new(timing, tracker.finish())
 }
 
-pub fn heavy_chain() -> Outcome {
+pub fn heavy_chain(h: f64, substeps: i32) -> Outcome {
     let mut w = world();
     let mut previous = ground(&mut w);
     let mut pins = Vec::with_capacity(chain::LINKS + 1);
@@ -189,8 +189,8 @@ pub fn heavy_chain() -> Outcome {
     let mut worst_gap: f64 = 0.0;
     let timing = measure(
         &mut w,
-        chain::STEPS,
-        |w| step(w, H),
+        chain::steps(h),
+        |w| step(w, h, substeps),
         |w, _| {
             for pin in &pins {
                 worst_gap = worst(worst_gap, pin.gap(w));
@@ -200,7 +200,7 @@ pub fn heavy_chain() -> Outcome {
     Outcome::new(timing, Metric::Chain { worst_gap })
 }
 
-pub fn bounce() -> Outcome {
+pub fn bounce(h: f64, substeps: i32) -> Outcome {
     let mut w = world();
     floor(&mut w);
     let half = 0.5 * bounce::SIZE;
@@ -215,8 +215,8 @@ pub fn bounce() -> Outcome {
     let mut tracker = ReboundTracker::default();
     let timing = measure(
         &mut w,
-        bounce::STEPS,
-        |w| step(w, H),
+        bounce::steps(h),
+        |w| step(w, h, substeps),
         |w, _| {
             let v_up = f64::from(w.body_linear_velocity(body).y);
             tracker.update(centre(w, body).1 - half, v_up);

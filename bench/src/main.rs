@@ -8,10 +8,12 @@ mod harness;
 mod pe_scenes;
 mod rapier_scenes;
 mod scene;
+mod sweep;
 
 use harness::{RUN_BUDGET, Timing, WARMUP_STEPS, WARMUP_WALL};
 use pe::ContactSolver;
-use scene::{Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain};
+use pe_scenes::PeConfig;
+use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -84,6 +86,27 @@ fn run_row(
 }
 
 fn main() {
+    let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench");
+    if std::env::args().nth(1).as_deref() == Some("sweep") {
+        let started = Instant::now();
+        let mut md = sweep::run(docs);
+        let _ = writeln!(
+            md,
+            "Machine: {}; load average at start: {}; {}; whole sweep {:.0} s.",
+            machine(),
+            load_average(),
+            today(),
+            started.elapsed().as_secs_f64()
+        );
+        let path = format!("{docs}/sweep.md");
+        if let Err(e) = std::fs::write(&path, &md) {
+            eprintln!("could not write {path}: {e}");
+            std::process::exit(1);
+        }
+        println!("{md}");
+        eprintln!("written to docs/bench/sweep.md");
+        return;
+    }
     let load = load_average();
     let started = Instant::now();
     let mut rows = Vec::new();
@@ -91,7 +114,7 @@ fn main() {
         rows.push(run_row(
             spec.name,
             "stands: drift 0, 0 fallen".into(),
-            |s| pe_scenes::pyramid(s, spec),
+            |s| pe_scenes::pyramid(PeConfig::new(s), spec),
             || rapier_scenes::pyramid(spec),
             || box2d_scenes::pyramid(spec),
         ));
@@ -100,24 +123,24 @@ fn main() {
         rows.push(run_row(
             spec.name,
             format!("T = {:.5} s, ΔE = 0", Pendulum::exact_period()),
-            |s| pe_scenes::pendulum(s, spec),
-            || rapier_scenes::pendulum(spec),
-            || box2d_scenes::pendulum(spec),
+            |s| pe_scenes::pendulum(PeConfig::new(s), spec),
+            || rapier_scenes::pendulum(spec, rapier_scenes::ITERATIONS),
+            || box2d_scenes::pendulum(spec, box2d_scenes::SUBSTEPS),
         ));
     }
     rows.push(run_row(
         chain::NAME,
         "gap 0".into(),
-        pe_scenes::heavy_chain,
-        rapier_scenes::heavy_chain,
-        box2d_scenes::heavy_chain,
+        |s| pe_scenes::heavy_chain(PeConfig::new(s), H),
+        || rapier_scenes::heavy_chain(H, rapier_scenes::ITERATIONS),
+        || box2d_scenes::heavy_chain(H, box2d_scenes::SUBSTEPS),
     ));
     rows.push(run_row(
         bounce::NAME,
         format!("peak e²·h = {} m", bounce::expected_peak()),
-        pe_scenes::bounce,
-        rapier_scenes::bounce,
-        box2d_scenes::bounce,
+        |s| pe_scenes::bounce(PeConfig::new(s), H),
+        || rapier_scenes::bounce(H, rapier_scenes::ITERATIONS),
+        || box2d_scenes::bounce(H, box2d_scenes::SUBSTEPS),
     ));
     let report = report(&rows, started.elapsed(), &load);
     println!("{report}");
@@ -130,7 +153,7 @@ fn main() {
 }
 
 /// A duration with three significant figures in a readable unit.
-fn pretty(d: Duration) -> String {
+pub fn pretty(d: Duration) -> String {
     let s = d.as_secs_f64();
     let (value, unit) = match s {
         s if s < 1e-3 => (s * 1e6, "µs"),

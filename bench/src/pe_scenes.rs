@@ -7,7 +7,30 @@ use crate::scene::{
     BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
     ReboundTracker, bounce, chain, worst,
 };
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, JointDef, JointHandle, Vec2, World};
+use pe::{
+    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle, Vec2,
+    World,
+};
+
+/// How pe is set up for a run: the contact solver, the integrator, and the soft step's
+/// substeps (used by `soft` only).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PeConfig {
+    pub solver: ContactSolver,
+    pub integrator: Integrator,
+    pub soft_substeps: usize,
+}
+
+impl PeConfig {
+    /// The solver with pe's defaults for the rest.
+    pub fn new(solver: ContactSolver) -> Self {
+        Self {
+            solver,
+            integrator: Integrator::default(),
+            soft_substeps: 4,
+        }
+    }
+}
 
 /// A scene point (y up) in pe's y-down world.
 fn at((x, y): (f64, f64)) -> Vec2 {
@@ -20,9 +43,11 @@ fn centre(world: &World, body: BodyHandle) -> (f64, f64) {
     (p.x, -p.y)
 }
 
-fn world(solver: ContactSolver) -> World {
+fn world(config: PeConfig) -> World {
     let mut w = World::new(Vec2::new(0.0, G));
-    w.settings.contact_solver = solver;
+    w.settings.contact_solver = config.solver;
+    w.settings.integrator = config.integrator;
+    w.settings.soft_substeps = config.soft_substeps;
     // All bodies are metre-sized: pe's tolerances (contact margin, slop, joint tolerance)
     // scale with this.
     w.settings.length_scale = 1.0;
@@ -43,8 +68,8 @@ fn floor(w: &mut World) {
     w.add_body(def).expect("valid floor");
 }
 
-pub fn pyramid(solver: ContactSolver, spec: &Pyramid) -> Outcome {
-    let mut w = world(solver);
+pub fn pyramid(config: PeConfig, spec: &Pyramid) -> Outcome {
+    let mut w = world(config);
     floor(&mut w);
     let unit = rectangle(BOX, BOX);
     let centres = spec.centres();
@@ -65,8 +90,8 @@ pub fn pyramid(solver: ContactSolver, spec: &Pyramid) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
-pub fn pendulum(solver: ContactSolver, spec: &Pendulum) -> Outcome {
-    let mut w = world(solver);
+pub fn pendulum(config: PeConfig, spec: &Pendulum) -> Outcome {
+    let mut w = world(config);
     let bob = w
         .add_body(BodyDef::new(rectangle(BOB, BOB), 1.0).at(at(Pendulum::bob_start()), 0.0))
         .expect("valid bob");
@@ -88,8 +113,8 @@ pub fn pendulum(solver: ContactSolver, spec: &Pendulum) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
-pub fn heavy_chain(solver: ContactSolver) -> Outcome {
-    let mut w = world(solver);
+pub fn heavy_chain(config: PeConfig, h: f64) -> Outcome {
+    let mut w = world(config);
     let link = rectangle(chain::LINK.0, chain::LINK.1);
     let mut joints: Vec<JointHandle> = Vec::with_capacity(chain::LINKS + 1);
     let mut previous: Option<BodyHandle> = None;
@@ -109,8 +134,8 @@ pub fn heavy_chain(solver: ContactSolver) -> Outcome {
     let mut worst_gap: f64 = 0.0;
     let timing = measure(
         &mut w,
-        chain::STEPS,
-        |w| w.step(H),
+        chain::steps(h),
+        |w| w.step(h),
         |w, _| {
             for &j in &joints {
                 worst_gap = worst(worst_gap, w.joint_gap(j).expect("joints are never removed"));
@@ -120,8 +145,8 @@ pub fn heavy_chain(solver: ContactSolver) -> Outcome {
     Outcome::new(timing, Metric::Chain { worst_gap })
 }
 
-pub fn bounce(solver: ContactSolver) -> Outcome {
-    let mut w = world(solver);
+pub fn bounce(config: PeConfig, h: f64) -> Outcome {
+    let mut w = world(config);
     floor(&mut w);
     let half = 0.5 * bounce::SIZE;
     let def = BodyDef::new(rectangle(bounce::SIZE, bounce::SIZE), 1.0)
@@ -131,8 +156,8 @@ pub fn bounce(solver: ContactSolver) -> Outcome {
     let mut tracker = ReboundTracker::default();
     let timing = measure(
         &mut w,
-        bounce::STEPS,
-        |w| w.step(H),
+        bounce::steps(h),
+        |w| w.step(h),
         |w, _| {
             let v_up = -w.body(body).expect("live").velocity.y;
             tracker.update(centre(w, body).1 - half, v_up);

@@ -20,11 +20,16 @@ fn centre(world: &PhysicsWorld, body: RigidBodyHandle) -> (f64, f64) {
     (f64::from(t.x), f64::from(t.y))
 }
 
-/// A world with the default integration parameters except the step.
-fn world(h: f64) -> PhysicsWorld {
+/// Rapier's default solver iterations per step.
+pub const ITERATIONS: usize = 4;
+
+/// A world with the default integration parameters except the step and the solver
+/// iterations.
+fn world(h: f64, iterations: usize) -> PhysicsWorld {
     let mut w = PhysicsWorld::new();
     w.gravity = Vector::new(0.0, -G as Real);
     w.integration_parameters.dt = h as Real;
+    w.integration_parameters.num_solver_iterations = iterations;
     w
 }
 
@@ -54,7 +59,7 @@ fn floor(w: &mut PhysicsWorld, restitution: f64) {
 }
 
 pub fn pyramid(spec: &Pyramid) -> Outcome {
-    let mut w = world(H);
+    let mut w = world(H, ITERATIONS);
     floor(&mut w, 0.0);
     let centres = spec.centres();
     let boxes: Vec<RigidBodyHandle> = centres
@@ -82,8 +87,8 @@ fn energy(world: &PhysicsWorld, body: RigidBodyHandle) -> f64 {
     kinetic + mass * G * f64::from(b.center_of_mass().y)
 }
 
-pub fn pendulum(spec: &Pendulum) -> Outcome {
-    let mut w = world(spec.h);
+pub fn pendulum(spec: &Pendulum, iterations: usize) -> Outcome {
+    let mut w = world(spec.h, iterations);
     // The pivot is a fixed body without collider at the origin.
     let pivot = w.insert_body(RigidBodyBuilder::fixed());
     let start = Pendulum::bob_start();
@@ -121,8 +126,8 @@ fn joint_gap(world: &PhysicsWorld, joint: ImpulseJointHandle) -> f64 {
     f64::from(a.distance(b))
 }
 
-pub fn heavy_chain() -> Outcome {
-    let mut w = world(H);
+pub fn heavy_chain(h: f64, iterations: usize) -> Outcome {
+    let mut w = world(h, iterations);
     let mut previous = (w.insert_body(RigidBodyBuilder::fixed()), (0.0, 0.0));
     let mut joints = Vec::with_capacity(chain::LINKS + 1);
     for i in 0..=chain::LINKS {
@@ -145,7 +150,7 @@ pub fn heavy_chain() -> Outcome {
         previous = (body, c);
     }
     let mut worst_gap: f64 = 0.0;
-    let timing = measure(&mut w, chain::STEPS, PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, chain::steps(h), PhysicsWorld::step, |w, _| {
         for &j in &joints {
             worst_gap = worst(worst_gap, joint_gap(w, j));
         }
@@ -153,8 +158,8 @@ pub fn heavy_chain() -> Outcome {
     Outcome::new(timing, Metric::Chain { worst_gap })
 }
 
-pub fn bounce() -> Outcome {
-    let mut w = world(H);
+pub fn bounce(h: f64, iterations: usize) -> Outcome {
+    let mut w = world(h, iterations);
     // Rapier averages the pair's restitutions by default: with 0.5 on both the pair's is 0.5.
     floor(&mut w, bounce::RESTITUTION);
     let half = 0.5 * bounce::SIZE;
@@ -163,7 +168,7 @@ pub fn bounce() -> Outcome {
         .restitution(bounce::RESTITUTION as Real);
     let (body, _) = w.insert(dynamic((0.0, bounce::DROP + half)), shape);
     let mut tracker = ReboundTracker::default();
-    let timing = measure(&mut w, bounce::STEPS, PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, bounce::steps(h), PhysicsWorld::step, |w, _| {
         let v_up = f64::from(w.bodies[body].linvel().y);
         tracker.update(centre(w, body).1 - half, v_up);
     });

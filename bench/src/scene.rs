@@ -235,7 +235,12 @@ pub mod chain {
     /// The end body: a 1 m square of 100 kg.
     pub const END_SIZE: f64 = 1.0;
     pub const END_DENSITY: f64 = 100.0;
-    pub const STEPS: usize = 600;
+    pub const SECONDS: f64 = 10.0;
+
+    /// Steps of `h` that make up the run.
+    pub fn steps(h: f64) -> usize {
+        (SECONDS / h).round() as usize
+    }
 
     /// Pin `i` (0 = the one to the world) is at (i, 0): the chain lies level along +x,
     /// so it is released horizontally and swings down.
@@ -261,7 +266,12 @@ pub mod bounce {
     /// Height of the box's bottom above the floor at release, m.
     pub const DROP: f64 = 2.0;
     /// 2 s: the fall takes 0.63 s and the rebound rises for 0.32 s.
-    pub const STEPS: usize = 120;
+    pub const SECONDS: f64 = 2.0;
+
+    /// Steps of `h` that make up the run.
+    pub fn steps(h: f64) -> usize {
+        (SECONDS / h).round() as usize
+    }
 
     pub fn expected_peak() -> f64 {
         RESTITUTION * RESTITUTION * DROP

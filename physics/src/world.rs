@@ -42,6 +42,8 @@ pub struct StepSettings {
     /// Whether a body that ends a step through or deep in a static body is put back to its
     /// time of impact (see `World::step`).
     pub continuous: bool,
+    /// Substeps per step of the soft step (`ContactSolver::Soft`); Box2D v3's default, 4.
+    pub soft_substeps: usize,
 }
 
 impl Default for StepSettings {
@@ -54,6 +56,7 @@ impl Default for StepSettings {
             dense_row_limit: crate::solver::simultaneous::DENSE_ROW_LIMIT,
             sleeping: false,
             continuous: true,
+            soft_substeps: 4,
         }
     }
 }
@@ -833,7 +836,10 @@ impl World {
         }));
         s.accelerations.push((Vec2::zeros(), 0.0));
         s.soft.step(
-            &SoftSettings::for_length_scale(self.settings.length_scale),
+            &SoftSettings {
+                substeps: self.settings.soft_substeps.max(1),
+                ..SoftSettings::for_length_scale(self.settings.length_scale)
+            },
             &mut s.solver_bodies,
             &s.accelerations,
             &mut self.contacts,

@@ -1,0 +1,38 @@
+//! A 20-row pyramid (210 unit boxes) under a chosen solver for profiling:
+//! `cargo run --release -p pe --example pyramid_profile -- soft 600`.
+use pe::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
+use std::time::Instant;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let solver = match args.next().as_deref() {
+        Some("exact") => ContactSolver::Exact,
+        Some("thesis") => ContactSolver::Thesis,
+        _ => ContactSolver::Soft,
+    };
+    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
+    let rows: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let mut w = World::new(Vec2::new(0.0, 10.0));
+    w.settings.contact_solver = solver;
+    w.friction = 0.6;
+    let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
+    w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+        .unwrap();
+    let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    for row in 0..rows {
+        for i in 0..rows - row {
+            let x = i as f64 - 0.5 * (rows - 1 - row) as f64;
+            w.add_body(BodyDef::new(unit.clone(), 1.0).at(Vec2::new(x, -0.5 - row as f64), 0.0))
+                .unwrap();
+        }
+    }
+    let started = Instant::now();
+    for _ in 0..steps {
+        w.step(1.0 / 60.0);
+    }
+    let per_step = started.elapsed().as_secs_f64() / steps as f64;
+    println!(
+        "{solver:?}: {rows} rows, {:.1} µs/step (mean of {steps})",
+        per_step * 1e6
+    );
+}
