@@ -30,5 +30,5 @@ pub use shape::{ConvexPolygon, MassProperties, ShapeError, convex_hull};
 pub use solver::ContactSolver;
 pub use solver::contact::Contact;
 pub use solver::joint::{Joint, JointHandle, JointMotor};
-pub use solver::motor::BodyMotor;
-pub use world::{Integrator, JointDef, JointError, StepSettings, World};
+pub use solver::motor::{BodyMotor, MotorError};
+pub use world::{Integrator, JointDef, JointError, StepError, StepSettings, World};

@@ -10,7 +10,7 @@ use crate::solver::joint::{
     Joint, JointBlockSolver, JointConstraint, JointHandle, JointIterations, JointMotor,
     JointSolver, velocity_gap_target,
 };
-use crate::solver::motor::BodyMotor;
+use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{FrictionModel, IslandReport, SimultaneousSolver};
 use crate::solver::soft::{SoftSettings, SoftStepSolver};
 use crate::solver::system::VelocityTargets;
@@ -128,6 +128,19 @@ pub enum JointError {
     SameBody,
     #[error("the joint anchor is not a finite point")]
     NonFiniteAnchor,
+    #[error("joint {0}")]
+    BadMotor(MotorError),
+}
+
+/// Why a step was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    #[error("the time step must be a finite number > 0, got {0}")]
+    BadTimeStep(f64),
+    #[error("gravity must be finite, got ({0}, {1})")]
+    BadGravity(f64, f64),
+    #[error("the world's friction must be a finite number ≥ 0, got {0}")]
+    BadFriction(f64),
 }
 
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
@@ -240,6 +253,9 @@ impl World {
         if Some(def.body_a) == def.body_b {
             return Err(JointError::SameBody);
         }
+        if let Some(m) = &def.motor {
+            m.validate().map_err(JointError::BadMotor)?;
+        }
         let a = self.body(def.body_a).ok_or(JointError::MissingBody)?;
         let local_anchor_a = a.to_local(def.anchor);
         let local_anchor_b = match def.body_b {
@@ -307,9 +323,14 @@ impl World {
     }
 
     /// Adds a thesis body motor (SPEC §4.4) driving `body`. Returns its index.
-    pub fn add_body_motor(&mut self, body: BodyHandle, motor: BodyMotor) -> usize {
+    pub fn add_body_motor(
+        &mut self,
+        body: BodyHandle,
+        motor: BodyMotor,
+    ) -> Result<usize, MotorError> {
+        motor.validate()?;
         self.body_motors.push((body, motor));
-        self.body_motors.len() - 1
+        Ok(self.body_motors.len() - 1)
     }
 
     pub fn body_motors(&self) -> &[(BodyHandle, BodyMotor)] {
@@ -397,7 +418,31 @@ impl World {
     /// for the next step's contacts to answer. Speculative contacts stop most fast bodies
     /// already; this catches what they miss (a spinning body, the soft step's contacts
     /// found only at the step's start).
+    ///
+    /// A step that would put a non-finite number into the state (see `try_step`) does
+    /// nothing.
     pub fn step(&mut self, dt: f64) {
+        let _refused = self.try_step(dt);
+    }
+
+    /// `step`, refusing a time step that is not finite and positive, non-finite gravity
+    /// or a world friction that is not a finite number ≥ 0, with the reason. (Bodies,
+    /// joints and motors are checked when they are added.)
+    pub fn try_step(&mut self, dt: f64) -> Result<(), StepError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(StepError::BadTimeStep(dt));
+        }
+        if !(self.gravity.x.is_finite() && self.gravity.y.is_finite()) {
+            return Err(StepError::BadGravity(self.gravity.x, self.gravity.y));
+        }
+        if !(self.friction.is_finite() && self.friction >= 0.0) {
+            return Err(StepError::BadFriction(self.friction));
+        }
+        self.advance(dt);
+        Ok(())
+    }
+
+    fn advance(&mut self, dt: f64) {
         if self.settings.sleeping {
             self.wake_where_needed(dt);
         }
@@ -458,8 +503,12 @@ impl World {
             let motion =
                 (sweep.end.0 - sweep.start.0).norm() + (sweep.end.1 - sweep.start.1).abs() * radius;
             // Fast bodies, and bodies an impact sent further than the contact margin (their
-            // contacts were found before the solve, for the motion they had then).
-            if motion <= (0.5 * inner_radius(body.local_vertices())).min(margin) {
+            // contacts were found before the solve, for the motion they had then). Moving a
+            // jointed body back opens its pins, so jointed bodies only when fast enough to
+            // pass through something: a wheel rolling over terrain is the contacts' job.
+            let fast = 0.5 * inner_radius(body.local_vertices());
+            let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
+            if motion <= if jointed { fast } else { fast.min(margin) } {
                 continue;
             }
             let swept = Aabb {

@@ -166,7 +166,8 @@ fn a_huge_torque_spins_a_body_without_breaking_the_world() {
             w.add_body(BodyDef::new(square.clone(), 1.0).at(Vec2::new(x, -0.5), 0.0))
                 .unwrap();
         }
-        w.add_body_motor(spinner, pe::BodyMotor::new(0, 600, 1e3, 1e12, 1e12, 0.0));
+        w.add_body_motor(spinner, pe::BodyMotor::new(0, 600, 1e3, 1e12, 1e12, 0.0))
+            .unwrap();
         for _ in 0..600 {
             w.step(H);
         }
@@ -589,4 +590,51 @@ proptest! {
         prop_assert!(thrown.energy_rise < 0.01, "{:?}: energy rose by {}", solver, thrown.energy_rise);
         prop_assert!(thrown.depth < 0.2, "{:?}: penetration {} of the smallest radius", solver, thrown.depth);
     }
+}
+
+#[test]
+fn numbers_that_would_poison_the_state_are_refused() {
+    use pe::{BodyMotor, JointDef, JointError, JointMotor, MotorError, StepError};
+    let mut w = World::new(Vec2::new(0.0, 10.0));
+    let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let a = w.add_body(BodyDef::new(square.clone(), 1.0)).unwrap();
+    let b = w
+        .add_body(BodyDef::new(square, 1.0).at(Vec2::new(1.0, 0.0), 0.0))
+        .unwrap();
+    // Bodies: non-finite placement, bad material (checked when added).
+    let bad = BodyDef::new(ConvexPolygon::rectangle(1.0, 1.0).unwrap(), 1.0)
+        .at(Vec2::new(f64::NAN, 0.0), 0.0);
+    assert!(w.add_body(bad).is_err());
+    // Motors.
+    let motor = |angular, max| BodyMotor::new(0, 10, angular, 1.0, max, 0.0);
+    assert!(matches!(
+        w.add_body_motor(a, motor(f64::NAN, 1.0)),
+        Err(MotorError::NonFinite("angular", _))
+    ));
+    assert!(matches!(
+        w.add_body_motor(a, motor(0.1, f64::INFINITY)),
+        Err(MotorError::NonFinite("max torque", _))
+    ));
+    assert!(matches!(
+        w.add_body_motor(a, motor(0.1, -1.0)),
+        Err(MotorError::Negative("max torque", _))
+    ));
+    let mut pin = JointDef::new(a, Some(b), Vec2::new(0.5, 0.0));
+    pin.motor = Some(JointMotor::new(f64::NAN, 1.0));
+    assert!(matches!(w.add_joint(pin), Err(JointError::BadMotor(_))));
+    assert!(w.body_motors().is_empty() && w.joints().next().is_none());
+    // Steps: the reason is given and nothing moves.
+    let before: Vec<_> = w.bodies().map(|(_, b)| (b.position, b.velocity)).collect();
+    for dt in [0.0, -0.01, f64::NAN, f64::INFINITY] {
+        assert!(matches!(w.try_step(dt), Err(StepError::BadTimeStep(_))));
+        w.step(dt);
+    }
+    w.gravity = Vec2::new(0.0, f64::NAN);
+    assert!(matches!(w.try_step(H), Err(StepError::BadGravity(..))));
+    w.gravity = Vec2::new(0.0, 10.0);
+    w.friction = -1.0;
+    assert!(matches!(w.try_step(H), Err(StepError::BadFriction(_))));
+    let after: Vec<_> = w.bodies().map(|(_, b)| (b.position, b.velocity)).collect();
+    assert_eq!(before, after);
+    assert_eq!(w.step_count(), 0);
 }

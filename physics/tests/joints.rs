@@ -245,7 +245,9 @@ fn body_motor_reaches_and_holds_its_target() {
     let dt = 0.01;
     // 0.003 rad/step at 0.01 s/step = 0.3 rad/s; I = 133 333, so 2e4 gives 0.15 rad/s².
     let (start, max) = (2e4, 3e4);
-    world.add_body_motor(body, BodyMotor::new(0, 500, 0.003, start, max, 0.01));
+    world
+        .add_body_motor(body, BodyMotor::new(0, 500, 0.003, start, max, 0.01))
+        .unwrap();
     let target = 0.003 / dt;
     // Bang-bang control overshoots by at most one step of the largest torque: 0.75%.
     let overshoot = max * dt / inertia;

@@ -120,7 +120,8 @@ fn motors_and_wake_body_wake_a_sleeping_island() {
     let (mut w, boxes) = piles(ContactSolver::Exact);
     let spinner = boxes[3]; // the top of the left pile
     // A motor that switches on at step 200, long after the pile has gone to sleep.
-    w.add_body_motor(spinner, BodyMotor::new(200, 400, 0.01, 50.0, 50.0, 0.0));
+    w.add_body_motor(spinner, BodyMotor::new(200, 400, 0.01, 50.0, 50.0, 0.0))
+        .unwrap();
     for _ in 0..200 {
         w.step(H);
     }

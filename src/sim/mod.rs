@@ -181,19 +181,20 @@ impl Simulation {
                 let p = &b.placement;
                 let id = format!("{prefix}/{}", p.alias);
                 let placed_by = PlacedBy::RobotBody { robot: i, body: k };
-                let handle = self.add_body(id, placed_by, p, compose(frame, placement_frame(p)))?;
+                let handle =
+                    self.add_body(id.clone(), placed_by, p, compose(frame, placement_frame(p)))?;
                 for m in &b.motors {
-                    self.world.add_body_motor(
-                        handle,
-                        pe::BodyMotor::new(
-                            m.time0,
-                            m.time1,
-                            m.angular,
-                            m.start_torque,
-                            m.max_torque,
-                            m.increase,
-                        ),
+                    let motor = pe::BodyMotor::new(
+                        m.time0,
+                        m.time1,
+                        m.angular,
+                        m.start_torque,
+                        m.max_torque,
+                        m.increase,
                     );
+                    self.world
+                        .add_body_motor(handle, motor)
+                        .map_err(|e| format!("{id}: {e}"))?;
                     self.body_motor_owners.push(self.bodies.len() - 1);
                 }
                 handles.push((p.alias.trim().to_string(), handle));

@@ -65,6 +65,21 @@ pub struct JointMotor {
 }
 
 impl JointMotor {
+    /// Both numbers finite, the torque bound non-negative.
+    pub fn validate(&self) -> Result<(), super::motor::MotorError> {
+        use super::motor::MotorError;
+        if !self.target_speed.is_finite() {
+            return Err(MotorError::NonFinite("target speed", self.target_speed));
+        }
+        if !self.max_torque.is_finite() {
+            return Err(MotorError::NonFinite("max torque", self.max_torque));
+        }
+        if self.max_torque < 0.0 {
+            return Err(MotorError::Negative("max torque", self.max_torque));
+        }
+        Ok(())
+    }
+
     pub fn new(target_speed: f64, max_torque: f64) -> Self {
         Self {
             target_speed,

@@ -1,6 +1,15 @@
 //! The thesis's body motor (SPEC §4.4): a torque couple on one body that ramps up while the
 //! body turns slower than its target and switches off when it gets there (bang-bang).
 
+/// Why a motor cannot be added.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MotorError {
+    #[error("motor {0} must be a finite number, got {1}")]
+    NonFinite(&'static str, f64),
+    #[error("motor {0} must not be negative, got {1}")]
+    Negative(&'static str, f64),
+}
+
 /// A body motor with the XML `<force>` fields. Times count steps; `angular` is radians per
 /// step and its sign gives the direction (SPEC §4.4 Rec).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,6 +43,28 @@ impl BodyMotor {
             increase,
             current: 0.0,
         }
+    }
+
+    /// Refuses what would put a non-finite torque into the world: every number must be
+    /// finite and the torques and their increase non-negative.
+    pub fn validate(&self) -> Result<(), MotorError> {
+        let fields = [
+            ("angular", self.angular),
+            ("start torque", self.start_torque),
+            ("max torque", self.max_torque),
+            ("increase", self.increase),
+        ];
+        for (name, value) in fields {
+            if !value.is_finite() {
+                return Err(MotorError::NonFinite(name, value));
+            }
+        }
+        for (name, value) in &fields[1..] {
+            if *value < 0.0 {
+                return Err(MotorError::Negative(name, *value));
+            }
+        }
+        Ok(())
     }
 
     /// Whether step `step` lies in the motor's window `time0 ≤ t < time1`.
