@@ -7,8 +7,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
-    ReboundTracker, bounce, chain, worst,
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
 };
 use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
 
@@ -220,6 +220,55 @@ pub fn bounce(h: f64, substeps: i32) -> Outcome {
         |w, _| {
             let v_up = f64::from(w.body_linear_velocity(body).y);
             tracker.update(centre(w, body).1 - half, v_up);
+        },
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn smash() -> Outcome {
+    let def = WorldDef::builder()
+        .gravity([0.0, 0.0])
+        .enable_sleep(false)
+        .build();
+    let mut w = World::new(def).expect("a valid world definition");
+    let mut bodies = Vec::with_capacity(smash::ROWS * smash::COLUMNS + 1);
+    for c in smash::small_centres() {
+        let size = (smash::SMALL, smash::SMALL);
+        bodies.push(boxed(&mut w, BodyType::Dynamic, c, size, 1.0, 0.0));
+    }
+    let size = (smash::HEAVY, smash::HEAVY);
+    let heavy = boxed(
+        &mut w,
+        BodyType::Dynamic,
+        smash::heavy_centre(),
+        size,
+        smash::HEAVY_DENSITY,
+        0.0,
+    );
+    w.set_body_linear_velocity(heavy, Vec2::new(smash::SPEED as f32, 0.0));
+    bodies.push(heavy);
+    let totals = |w: &World| {
+        let (mut p, mut e) = ((0.0, 0.0), 0.0);
+        for &b in &bodies {
+            let m = f64::from(w.body_mass(b));
+            let i = f64::from(w.body_rotational_inertia(b));
+            let v = w.body_linear_velocity(b);
+            let (vx, vy) = (f64::from(v.x), f64::from(v.y));
+            let omega = f64::from(w.body_angular_velocity(b));
+            p = (p.0 + m * vx, p.1 + m * vy);
+            e += 0.5 * m * (vx * vx + vy * vy) + 0.5 * i * omega * omega;
+        }
+        (p, e)
+    };
+    let (p0, e0) = totals(&w);
+    let mut tracker = MomentumTracker::new(p0, e0);
+    let timing = measure(
+        &mut w,
+        smash::STEPS,
+        |w| step(w, H, SUBSTEPS),
+        |w, _| {
+            let (p, e) = totals(w);
+            tracker.update(p, e);
         },
     );
     Outcome::new(timing, tracker.finish())

@@ -13,7 +13,7 @@ mod sweep;
 use harness::{RUN_BUDGET, Timing, WARMUP_STEPS, WARMUP_WALL};
 use pe::ContactSolver;
 use pe_scenes::PeConfig;
-use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain};
+use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain, smash};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -142,6 +142,13 @@ fn main() {
         || rapier_scenes::bounce(H, rapier_scenes::ITERATIONS),
         || box2d_scenes::bounce(H, box2d_scenes::SUBSTEPS),
     ));
+    rows.push(run_row(
+        smash::NAME,
+        "momentum drift 0; energy falls".into(),
+        |s| pe_scenes::smash(PeConfig::new(s)),
+        rapier_scenes::smash,
+        box2d_scenes::smash,
+    ));
     let report = report(&rows, started.elapsed(), &load);
     println!("{report}");
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench/results.md");
@@ -235,7 +242,9 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
     let _ = writeln!(
         w,
         "- Step h = 1/60 s except where the scene says; g = 10 m/s². pyramid40 is planned \
-         for 300 steps (5 s) instead of 600 to bound the run time; the pendulums run 60 s."
+         for 300 steps (5 s) instead of 600 to bound the run time; large_pyramid (base 100, \
+         5,050 boxes) for 500 steps as in Box2D's benchmark; smash (an 8 m box of density 10 \
+         at 40 m/s into 120 × 80 boxes of 0.5 m, no gravity) for 300; the pendulums run 60 s."
     );
     let _ = writeln!(w, "- Whole benchmark: {:.0} s.\n", elapsed.as_secs_f64());
 
@@ -296,7 +305,9 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
          widths, and how many boxes ever moved more than half a box vertically; pendulums — \
          period from upward zero crossings of x against the exact compound-pendulum period, \
          and max |E − E0| / (m g L); heavychain — widest joint gap at any step (link \
-         length 1 m); bounce — first rebound peak of the box's bottom against e²·h."
+         length 1 m); bounce — first rebound peak of the box's bottom against e²·h; smash \
+         — the largest drift of the total linear momentum from its start (no gravity, no \
+         static body: it is conserved exactly), and the kinetic energy left at the end."
     );
     md
 }

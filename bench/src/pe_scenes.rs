@@ -4,8 +4,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
-    ReboundTracker, bounce, chain, worst,
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
 };
 use pe::{
     BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle, Vec2,
@@ -162,6 +162,32 @@ pub fn bounce(config: PeConfig, h: f64) -> Outcome {
             let v_up = -w.body(body).expect("live").velocity.y;
             tracker.update(centre(w, body).1 - half, v_up);
         },
+    );
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn smash(config: PeConfig) -> Outcome {
+    let mut w = world(config);
+    w.gravity = Vec2::zeros();
+    let small = rectangle(smash::SMALL, smash::SMALL);
+    for c in smash::small_centres() {
+        w.add_body(BodyDef::new(small.clone(), 1.0).at(at(c), 0.0))
+            .expect("valid box");
+    }
+    let heavy = BodyDef::new(rectangle(smash::HEAVY, smash::HEAVY), smash::HEAVY_DENSITY)
+        .at(at(smash::heavy_centre()), 0.0)
+        .velocity(Vec2::new(smash::SPEED, 0.0), 0.0);
+    w.add_body(heavy).expect("valid box");
+    let momentum = |w: &World| {
+        let p = w.linear_momentum();
+        (p.x, -p.y)
+    };
+    let mut tracker = MomentumTracker::new(momentum(&w), w.kinetic_energy());
+    let timing = measure(
+        &mut w,
+        smash::STEPS,
+        |w| w.step(H),
+        |w, _| tracker.update(momentum(w), w.kinetic_energy()),
     );
     Outcome::new(timing, tracker.finish())
 }

@@ -5,8 +5,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid, PyramidTracker,
-    ReboundTracker, bounce, chain, worst,
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
 };
 use rapier2d::prelude::*;
 
@@ -171,6 +171,48 @@ pub fn bounce(h: f64, iterations: usize) -> Outcome {
     let timing = measure(&mut w, bounce::steps(h), PhysicsWorld::step, |w, _| {
         let v_up = f64::from(w.bodies[body].linvel().y);
         tracker.update(centre(w, body).1 - half, v_up);
+    });
+    Outcome::new(timing, tracker.finish())
+}
+
+pub fn smash() -> Outcome {
+    let mut w = world(H, ITERATIONS);
+    w.gravity = Vector::ZERO;
+    let mut bodies = Vec::with_capacity(smash::ROWS * smash::COLUMNS + 1);
+    for c in smash::small_centres() {
+        let shape = cuboid(smash::SMALL, smash::SMALL, 1.0).friction(FRICTION as Real);
+        bodies.push(w.insert(dynamic(c), shape).0);
+    }
+    let heavy = dynamic(smash::heavy_centre()).linvel(Vector::new(smash::SPEED as Real, 0.0));
+    let shape = cuboid(smash::HEAVY, smash::HEAVY, smash::HEAVY_DENSITY).friction(FRICTION as Real);
+    bodies.push(w.insert(heavy, shape).0);
+    let PhysicsWorld {
+        bodies: set,
+        colliders,
+        ..
+    } = &mut w;
+    for &b in &bodies {
+        set[b].recompute_mass_properties_from_colliders(colliders);
+    }
+    let totals = |w: &PhysicsWorld| {
+        let (mut p, mut e) = ((0.0, 0.0), 0.0);
+        for &b in &bodies {
+            let body = &w.bodies[b];
+            let m = f64::from(body.mass());
+            let v = body.linvel();
+            let (vx, vy) = (f64::from(v.x), f64::from(v.y));
+            let i = f64::from(body.mass_properties().local_mprops.principal_inertia());
+            let omega = f64::from(body.angvel());
+            p = (p.0 + m * vx, p.1 + m * vy);
+            e += 0.5 * m * (vx * vx + vy * vy) + 0.5 * i * omega * omega;
+        }
+        (p, e)
+    };
+    let (p0, e0) = totals(&w);
+    let mut tracker = MomentumTracker::new(p0, e0);
+    let timing = measure(&mut w, smash::STEPS, PhysicsWorld::step, |w, _| {
+        let (p, e) = totals(w);
+        tracker.update(p, e);
     });
     Outcome::new(timing, tracker.finish())
 }

@@ -17,7 +17,7 @@ pub const FRICTION: f64 = 0.6;
 /// Side of a pyramid box, m.
 pub const BOX: f64 = 1.0;
 /// Size of the static floor, m; its top face is the line y = 0.
-pub const FLOOR: (f64, f64) = (100.0, 1.0);
+pub const FLOOR: (f64, f64) = (200.0, 1.0);
 
 /// The larger of a running worst value and a new sample, where a NaN sample (an engine
 /// that blew up) counts as infinitely bad rather than being skipped as `f64::max` would.
@@ -37,7 +37,7 @@ pub struct Pyramid {
     pub steps: usize,
 }
 
-pub const PYRAMIDS: [Pyramid; 2] = [
+pub const PYRAMIDS: [Pyramid; 3] = [
     Pyramid {
         name: "pyramid20",
         rows: 20,
@@ -48,6 +48,12 @@ pub const PYRAMIDS: [Pyramid; 2] = [
         name: "pyramid40",
         rows: 40,
         steps: 300,
+    },
+    // Box2D's large_pyramid benchmark: base 100, 5,050 boxes, 500 steps.
+    Pyramid {
+        name: "large_pyramid",
+        rows: 100,
+        steps: 500,
     },
 ];
 
@@ -314,6 +320,67 @@ impl ReboundTracker {
     }
 }
 
+/// Smash: a heavy box at 40 m/s into a block of 120 × 80 small boxes, no gravity, no
+/// static body. Nothing but the bodies exchanges momentum, so the total linear momentum is
+/// conserved exactly, and with restitution 0 the kinetic energy can only fall.
+pub mod smash {
+    pub const NAME: &str = "smash";
+    pub const COLUMNS: usize = 120;
+    pub const ROWS: usize = 80;
+    /// Small boxes, touching: the block is 60 × 40 m with its lower left corner at (0, 0).
+    pub const SMALL: f64 = 0.5;
+    pub const HEAVY: f64 = 8.0;
+    pub const HEAVY_DENSITY: f64 = 10.0;
+    pub const SPEED: f64 = 40.0;
+    pub const STEPS: usize = 300;
+
+    pub fn small_centres() -> Vec<(f64, f64)> {
+        (0..ROWS)
+            .flat_map(|r| {
+                (0..COLUMNS).map(move |c| ((c as f64 + 0.5) * SMALL, (r as f64 + 0.5) * SMALL))
+            })
+            .collect()
+    }
+
+    /// The heavy box starts 10 m left of the block, level with its middle.
+    pub fn heavy_centre() -> (f64, f64) {
+        (-10.0 - 0.5 * HEAVY, 0.5 * ROWS as f64 * SMALL)
+    }
+}
+
+/// Watches a scene's total linear momentum and kinetic energy against their start.
+pub struct MomentumTracker {
+    start: (f64, f64),
+    start_energy: f64,
+    worst: f64,
+    energy_ratio: f64,
+}
+
+impl MomentumTracker {
+    pub fn new(momentum: (f64, f64), energy: f64) -> Self {
+        Self {
+            start: momentum,
+            start_energy: energy,
+            worst: 0.0,
+            energy_ratio: 1.0,
+        }
+    }
+
+    pub fn update(&mut self, momentum: (f64, f64), energy: f64) {
+        let size = self.start.0.hypot(self.start.1);
+        let drift = (momentum.0 - self.start.0).hypot(momentum.1 - self.start.1) / size;
+        self.worst = worst(self.worst, drift);
+        self.energy_ratio = energy / self.start_energy;
+    }
+
+    pub fn finish(&self) -> Metric {
+        Metric::Momentum {
+            drift: self.worst,
+            energy_ratio: self.energy_ratio,
+        }
+    }
+}
+
 /// A scene's error or stability figure.
 #[derive(Debug, Clone, Copy)]
 pub enum Metric {
@@ -340,6 +407,12 @@ pub enum Metric {
         peak: f64,
         /// (peak − expected) / expected.
         error: f64,
+    },
+    Momentum {
+        /// Largest |P − P0| / |P0| over the run.
+        drift: f64,
+        /// Kinetic energy at the end over at the start.
+        energy_ratio: f64,
     },
 }
 
@@ -373,6 +446,14 @@ impl fmt::Display for Metric {
             Metric::Bounce { peak, error } => {
                 write!(f, "peak {peak:.4} m, error {:+.2}%", 100.0 * error)
             }
+            Metric::Momentum {
+                drift,
+                energy_ratio,
+            } => write!(
+                f,
+                "momentum drift {drift:.1e} of P0; kinetic energy {:.1}% of the start",
+                100.0 * energy_ratio
+            ),
         }
     }
 }
