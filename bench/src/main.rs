@@ -302,7 +302,8 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
     let _ = writeln!(
         w,
         "\nMetrics: pyramids — the top box's sideways displacement over the run in box \
-         widths, and how many boxes ever moved more than half a box vertically; pendulums — \
+         widths, the most it sank (box heights: soft contacts sag under the load), and how \
+         many boxes ever moved more than half a box sideways; pendulums — \
          period from upward zero crossings of x against the exact compound-pendulum period, \
          and max |E − E0| / (m g L); heavychain — widest joint gap at any step (link \
          length 1 m); bounce — first rebound peak of the box's bottom against e²·h; smash \

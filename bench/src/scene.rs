@@ -73,38 +73,45 @@ impl Pyramid {
     }
 }
 
-/// Follows every box of a pyramid: how far the top box slid sideways, and which boxes
-/// fell (their height changed by more than half a box at some point of the run).
+/// Follows every box of a pyramid: how far the top box slid sideways and sank, and which
+/// boxes fell: moved more than half a box sideways at some point of the run. (Not height:
+/// a 100-row pyramid of soft contacts sags by more than half a box under its own weight
+/// without any box leaving its place; the top box's sag is reported on its own.)
 pub struct PyramidTracker {
     start: Vec<(f64, f64)>,
     fallen: Vec<bool>,
-    top_x: f64,
+    top: (f64, f64),
+    worst_sag: f64,
 }
 
 impl PyramidTracker {
     pub fn new(start: Vec<(f64, f64)>) -> Self {
-        let top_x = start.last().map_or(0.0, |c| c.0);
+        let top = start.last().copied().unwrap_or_default();
         Self {
             fallen: vec![false; start.len()],
             start,
-            top_x,
+            top,
+            worst_sag: 0.0,
         }
     }
 
     /// Centres now, y up, in the order given to `new`.
     pub fn update(&mut self, centres: impl Iterator<Item = (f64, f64)>) {
         for (i, (x, y)) in centres.enumerate() {
-            let moved = (y - self.start[i].1).abs();
-            // A NaN height (the engine blew up) counts as fallen.
-            self.fallen[i] |= moved.is_nan() || moved > 0.5 * BOX;
-            self.top_x = x;
+            let moved = (x - self.start[i].0).abs();
+            // A NaN position (the engine blew up) counts as fallen.
+            self.fallen[i] |= moved.is_nan() || y.is_nan() || moved > 0.5 * BOX;
+            self.top = (x, y);
         }
+        let top_start = self.start.last().map_or(0.0, |c| c.1);
+        self.worst_sag = worst(self.worst_sag, (top_start - self.top.1) / BOX);
     }
 
     pub fn finish(&self) -> Metric {
         let top_start = self.start.last().map_or(0.0, |c| c.0);
         Metric::Pyramid {
-            top_drift: (self.top_x - top_start).abs() / BOX,
+            top_drift: (self.top.0 - top_start).abs() / BOX,
+            top_sag: self.worst_sag,
             fallen: self.fallen.iter().filter(|&&f| f).count(),
             boxes: self.start.len(),
         }
@@ -387,6 +394,8 @@ pub enum Metric {
     Pyramid {
         /// Top box's sideways displacement over the run, in box widths.
         top_drift: f64,
+        /// The most the top box sank below its start, in box heights.
+        top_sag: f64,
         fallen: usize,
         boxes: usize,
     },
@@ -421,12 +430,14 @@ impl fmt::Display for Metric {
         match *self {
             Metric::Pyramid {
                 top_drift,
+                top_sag,
                 fallen,
                 boxes,
             } => write!(
                 f,
-                "top drift {:.2}% of width; {fallen}/{boxes} fallen",
-                100.0 * top_drift
+                "top drift {:.2}% of width, sag {:.2}; {fallen}/{boxes} fallen",
+                100.0 * top_drift,
+                top_sag
             ),
             Metric::Pendulum {
                 period_error,
