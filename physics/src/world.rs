@@ -1136,12 +1136,15 @@ impl World {
         };
         let solver = self.settings.contact_solver;
         match solver {
-            ContactSolver::Sequential | ContactSolver::Soft => solve_sequential(
-                &mut self.contacts,
-                &mut s.solver_bodies,
-                dt,
-                targets.bounce_below,
-            ),
+            ContactSolver::Sequential | ContactSolver::Soft => {
+                s.simultaneous.reports.clear();
+                solve_sequential(
+                    &mut self.contacts,
+                    &mut s.solver_bodies,
+                    dt,
+                    targets.bounce_below,
+                )
+            }
             ContactSolver::Thesis | ContactSolver::Exact => {
                 let model = if solver == ContactSolver::Thesis {
                     FrictionModel::TwoStage
@@ -1183,9 +1186,15 @@ impl World {
         self.scatter_solver_bodies();
     }
 
-    /// How each island was solved in the last step (simultaneous solvers only).
+    /// How each island was solved in the last step: by which method (see
+    /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
+    /// `thesis` the last substep's islands; under `soft` the step's.
     pub fn island_reports(&self) -> &[IslandReport] {
-        &self.scratch.simultaneous.reports
+        if self.settings.contact_solver == ContactSolver::Soft {
+            &self.scratch.soft.reports
+        } else {
+            &self.scratch.simultaneous.reports
+        }
     }
 
     /// Positions follow velocities (SPEC §3.4 step 7).

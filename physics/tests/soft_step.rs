@@ -115,3 +115,74 @@ fn a_light_chain_holds_a_load_500_times_heavier() {
     }
     assert!(worst < 0.02, "a pin opened to {worst} link lengths");
 }
+
+#[test]
+fn the_world_reports_how_each_island_was_solved() {
+    use pe::solver::simultaneous::IslandMethod;
+    // Two islands on one floor: a box 1,000 times heavier on a light one, and a row of
+    // three like boxes; plus a lone pendulum and a chain of three pins.
+    let build = |solver: ContactSolver| {
+        let mut w = World::new(Vec2::new(0.0, G));
+        w.settings.contact_solver = solver;
+        let floor = ConvexPolygon::rectangle(40.0, 1.0).unwrap();
+        w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for (x, y, density) in [(-10.0, -0.5, 1.0), (-10.0, -1.5, 1000.0)] {
+            w.add_body(BodyDef::new(unit.clone(), density).at(Vec2::new(x, y), 0.0))
+                .unwrap();
+        }
+        for x in [5.0, 6.0, 7.0] {
+            w.add_body(BodyDef::new(unit.clone(), 1.0).at(Vec2::new(x, -0.5), 0.0))
+                .unwrap();
+        }
+        let link = ConvexPolygon::rectangle(1.0, 0.2).unwrap();
+        let mut previous = None;
+        for i in 0..3 {
+            let b = w
+                .add_body(
+                    BodyDef::new(link.clone(), 1.0).at(Vec2::new(20.5 + i as f64, -20.0), 0.0),
+                )
+                .unwrap();
+            w.add_joint(JointDef::new(
+                b,
+                previous,
+                Vec2::new(20.0 + i as f64, -20.0),
+            ))
+            .unwrap();
+            previous = Some(b);
+        }
+        let bob = w
+            .add_body(BodyDef::new(unit.clone(), 1.0).at(Vec2::new(-20.0, -20.0), 0.0))
+            .unwrap();
+        w.add_joint(JointDef::new(bob, None, Vec2::new(-21.0, -20.0)))
+            .unwrap();
+        w.step(H);
+        let mut methods: Vec<_> = w
+            .island_reports()
+            .iter()
+            .map(|r| (format!("{:?}", r.method), r.contacts, r.joints))
+            .collect();
+        methods.sort();
+        methods
+    };
+    let name = |m: IslandMethod| format!("{m:?}");
+    assert_eq!(
+        build(ContactSolver::Soft),
+        vec![
+            (name(IslandMethod::SoftLcp), 4, 0),
+            (name(IslandMethod::SoftPinBlock), 0, 3),
+            (name(IslandMethod::SoftPinByPin), 0, 1),
+            (name(IslandMethod::SoftPointByPoint), 10, 0),
+        ]
+    );
+    // The exact solver puts contacts and pins of an island in one LCP; all are small.
+    let exact = build(ContactSolver::Exact);
+    assert!(
+        exact
+            .iter()
+            .all(|(m, ..)| *m == name(IslandMethod::Pivoting)),
+        "{exact:?}"
+    );
+    assert_eq!(exact.len(), 4, "{exact:?}");
+}

@@ -15,15 +15,32 @@ use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 /// a step.
 pub const DENSE_ROW_LIMIT: usize = 96;
 
+/// How an island's constraints were solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IslandMethod {
+    /// `exact`/`thesis`: the dense LCP by pivoting (up to `StepSettings::dense_row_limit`
+    /// rows).
+    Pivoting,
+    /// `exact`/`thesis` above the row limit: projected Gauss–Seidel row by row.
+    GaussSeidel,
+    /// `soft`: a contact island of very different masses, one LCP per pass.
+    SoftLcp,
+    /// `soft`: contacts point by point (two-point manifolds as a 2 × 2 block).
+    SoftPointByPoint,
+    /// `soft`: an island of pins, solved as one linear system per pass.
+    SoftPinBlock,
+    /// `soft`: pins one by one (a lone pin, or an island above the block limit).
+    SoftPinByPin,
+}
+
 /// What happened in one island during the last step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IslandReport {
     pub contacts: usize,
     pub joints: usize,
     pub rows: usize,
-    /// Whether the dense pivoting solve was used (else Gauss–Seidel row by row).
-    pub pivoting: bool,
-    /// Pivots made, or Gauss–Seidel sweeps.
+    pub method: IslandMethod,
+    /// Pivots made, or Gauss–Seidel sweeps (0 for the soft step's islands).
     pub pivots: usize,
     /// The LCP's complementarity residual (NaN for Gauss–Seidel row by row, which never
     /// forms the matrix the residual is measured against).
@@ -284,7 +301,11 @@ impl SimultaneousSolver {
                 contacts: self.island_contacts.len(),
                 joints: self.island_joints.len(),
                 rows: n,
-                pivoting,
+                method: if pivoting {
+                    IslandMethod::Pivoting
+                } else {
+                    IslandMethod::GaussSeidel
+                },
                 pivots,
                 residual,
             });
