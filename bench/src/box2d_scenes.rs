@@ -8,7 +8,7 @@ use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
     BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
+    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
 };
 use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
 
@@ -272,4 +272,43 @@ pub fn smash() -> Outcome {
         },
     );
     Outcome::new(timing, tracker.finish())
+}
+
+pub fn joint_grid() -> Outcome {
+    let mut w = world();
+    let mut bodies = Vec::with_capacity(joint_grid::N * joint_grid::N);
+    for r in 0..joint_grid::N {
+        for c in 0..joint_grid::N {
+            let kind = if joint_grid::is_static(r, c) {
+                BodyType::Static
+            } else {
+                BodyType::Dynamic
+            };
+            let size = (joint_grid::SIZE, joint_grid::SIZE);
+            bodies.push(boxed(
+                &mut w,
+                kind,
+                joint_grid::centre(r, c),
+                size,
+                1.0,
+                0.0,
+            ));
+        }
+    }
+    let pins: Vec<Pin> = joint_grid::pins()
+        .into_iter()
+        .map(|(a, b, p)| Pin::new(&mut w, bodies[a], bodies[b], p))
+        .collect();
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(
+        &mut w,
+        joint_grid::STEPS,
+        |w| step(w, H, SUBSTEPS),
+        |w, _| {
+            for pin in &pins {
+                worst_gap = worst(worst_gap, pin.gap(w));
+            }
+        },
+    );
+    Outcome::new(timing, Metric::Chain { worst_gap })
 }

@@ -13,7 +13,7 @@ mod sweep;
 use harness::{RUN_BUDGET, Timing, WARMUP_STEPS, WARMUP_WALL};
 use pe::ContactSolver;
 use pe_scenes::PeConfig;
-use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain, smash};
+use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain, joint_grid, smash};
 use std::fmt::Write as _;
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
@@ -141,6 +141,13 @@ fn main() {
         |s| pe_scenes::bounce(PeConfig::new(s), H),
         || rapier_scenes::bounce(H, rapier_scenes::ITERATIONS),
         || box2d_scenes::bounce(H, box2d_scenes::SUBSTEPS),
+    ));
+    rows.push(run_row(
+        joint_grid::NAME,
+        "gap 0".into(),
+        |s| pe_scenes::joint_grid(PeConfig::new(s)),
+        rapier_scenes::joint_grid,
+        box2d_scenes::joint_grid,
     ));
     rows.push(run_row(
         smash::NAME,
@@ -306,7 +313,7 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
          many boxes ever moved more than half a box sideways; pendulums — \
          period from upward zero crossings of x against the exact compound-pendulum period, \
          and max |E − E0| / (m g L); heavychain — widest joint gap at any step (link \
-         length 1 m); bounce — first rebound peak of the box's bottom against e²·h; smash \
+         length 1 m; joint_grid the same, bodies 1 m apart); bounce — first rebound peak of the box's bottom against e²·h; smash \
          — the largest drift of the total linear momentum from its start (no gravity, no \
          static body: it is conserved exactly), and the kinetic energy left at the end."
     );

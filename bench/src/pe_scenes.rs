@@ -5,7 +5,7 @@ use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
     BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
+    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
 };
 use pe::{
     BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle, Vec2,
@@ -190,4 +190,40 @@ pub fn smash(config: PeConfig) -> Outcome {
         |w, _| tracker.update(momentum(w), w.kinetic_energy()),
     );
     Outcome::new(timing, tracker.finish())
+}
+
+pub fn joint_grid(config: PeConfig) -> Outcome {
+    let mut w = world(config);
+    let square = rectangle(joint_grid::SIZE, joint_grid::SIZE);
+    let mut bodies = Vec::with_capacity(joint_grid::N * joint_grid::N);
+    for r in 0..joint_grid::N {
+        for c in 0..joint_grid::N {
+            let density = if joint_grid::is_static(r, c) {
+                0.0
+            } else {
+                1.0
+            };
+            let def = BodyDef::new(square.clone(), density).at(at(joint_grid::centre(r, c)), 0.0);
+            bodies.push(w.add_body(def).expect("valid square"));
+        }
+    }
+    let pins: Vec<JointHandle> = joint_grid::pins()
+        .into_iter()
+        .map(|(a, b, p)| {
+            w.add_joint(JointDef::new(bodies[a], Some(bodies[b]), at(p)))
+                .expect("valid pin")
+        })
+        .collect();
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(
+        &mut w,
+        joint_grid::STEPS,
+        |w| w.step(H),
+        |w, _| {
+            for &j in &pins {
+                worst_gap = worst(worst_gap, w.joint_gap(j).expect("joints are never removed"));
+            }
+        },
+    );
+    Outcome::new(timing, Metric::Chain { worst_gap })
 }

@@ -6,7 +6,7 @@ use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
     BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, smash, worst,
+    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
 };
 use rapier2d::prelude::*;
 
@@ -215,4 +215,39 @@ pub fn smash() -> Outcome {
         tracker.update(p, e);
     });
     Outcome::new(timing, tracker.finish())
+}
+
+pub fn joint_grid() -> Outcome {
+    let mut w = world(H, ITERATIONS);
+    let mut bodies = Vec::with_capacity(joint_grid::N * joint_grid::N);
+    for r in 0..joint_grid::N {
+        for c in 0..joint_grid::N {
+            let at = joint_grid::centre(r, c);
+            let body = if joint_grid::is_static(r, c) {
+                RigidBodyBuilder::fixed().translation(point(at))
+            } else {
+                dynamic(at)
+            };
+            let shape = cuboid(joint_grid::SIZE, joint_grid::SIZE, 1.0);
+            bodies.push((w.insert(body, shape).0, at));
+        }
+    }
+    let joints: Vec<ImpulseJointHandle> = joint_grid::pins()
+        .into_iter()
+        .map(|(a, b, p)| {
+            let ((ha, ca), (hb, cb)) = (bodies[a], bodies[b]);
+            let pin = RevoluteJointBuilder::new()
+                .local_anchor1(point(p) - point(ca))
+                .local_anchor2(point(p) - point(cb))
+                .contacts_enabled(false);
+            w.insert_impulse_joint(ha, hb, pin)
+        })
+        .collect();
+    let mut worst_gap: f64 = 0.0;
+    let timing = measure(&mut w, joint_grid::STEPS, PhysicsWorld::step, |w, _| {
+        for &j in &joints {
+            worst_gap = worst(worst_gap, joint_gap(w, j));
+        }
+    });
+    Outcome::new(timing, Metric::Chain { worst_gap })
 }

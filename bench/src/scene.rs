@@ -355,6 +355,43 @@ pub mod smash {
     }
 }
 
+/// Joint grid (Box2D's benchmark): 100 × 100 bodies 1 m apart, each pinned to its right and
+/// lower neighbours halfway between them, hanging from the seven middle bodies of the top
+/// row, which are static. The pins should hold: their gap is the error.
+pub mod joint_grid {
+    pub const NAME: &str = "joint_grid";
+    pub const N: usize = 100;
+    /// Squares 0.8 m wide: neighbours do not touch, so only the pins act.
+    pub const SIZE: f64 = 0.8;
+    pub const STEPS: usize = 300;
+
+    /// Body (row, column) centre; row 0 is the top, at y = 0.
+    pub fn centre(row: usize, column: usize) -> (f64, f64) {
+        (column as f64, -(row as f64))
+    }
+
+    pub fn is_static(row: usize, column: usize) -> bool {
+        row == 0 && (N / 2 - 3..=N / 2 + 3).contains(&column)
+    }
+
+    /// Pins as (body index a, body index b, world point), bodies numbered row by row.
+    pub fn pins() -> Vec<(usize, usize, (f64, f64))> {
+        let mut pins = Vec::with_capacity(2 * N * N);
+        for r in 0..N {
+            for c in 0..N {
+                let i = r * N + c;
+                if c + 1 < N {
+                    pins.push((i, i + 1, (c as f64 + 0.5, -(r as f64))));
+                }
+                if r + 1 < N {
+                    pins.push((i, i + N, (c as f64, -(r as f64) - 0.5)));
+                }
+            }
+        }
+        pins
+    }
+}
+
 /// Watches a scene's total linear momentum and kinetic energy against their start.
 pub struct MomentumTracker {
     start: (f64, f64),
