@@ -69,6 +69,13 @@ pub struct SimultaneousSolver {
     pseudo: Vec<SolverBody>,
     /// Velocities of an island's bodies during the row-by-row Gauss–Seidel.
     sparse_bodies: Vec<SolverBody>,
+    /// Last solve's contact impulses by (body A, body B, feature), sorted: the row-by-row
+    /// Gauss–Seidel starts from them (warm start) instead of from zero.
+    memory: Vec<((u32, u32, u32), f64, f64)>,
+    /// Each contact's key into `memory`, by its index in this solve's contacts.
+    keys: Vec<(u32, u32, u32)>,
+    /// The starting impulses of the rows being solved (empty: start from zero).
+    guess: Vec<f64>,
     /// Each row's `A_ii`, for the row-by-row Gauss–Seidel.
     diagonals: Vec<f64>,
     stage_one: Vec<f64>,
@@ -101,6 +108,9 @@ impl SimultaneousSolver {
         targets: &VelocityTargets,
     ) {
         self.reports.clear();
+        self.keys.clear();
+        self.keys
+            .extend(contacts.iter().map(|c| (c.body_a, c.body_b, c.id.0)));
         self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
         for island in 0..self.ranges.len() {
             self.load_island(island, contacts, joints);
@@ -109,6 +119,33 @@ impl SimultaneousSolver {
                 FrictionModel::Coupled => self.solve_coupled(bodies, targets),
             }
             self.write_back(contacts, joints);
+        }
+        self.memory.clear();
+        self.memory.extend(
+            contacts
+                .iter()
+                .zip(&self.keys)
+                .map(|(c, &k)| (k, c.normal_impulse, c.tangent_impulse)),
+        );
+        self.memory.sort_unstable_by_key(|m| m.0);
+    }
+
+    /// Starting impulses for the rows from the last solve's, for contacts that persist.
+    fn remember(&mut self) {
+        self.guess.clear();
+        for row in &self.rows {
+            let recalled = |i: u32| {
+                let key = self.keys[i as usize];
+                self.memory
+                    .binary_search_by(|m| m.0.cmp(&key))
+                    .ok()
+                    .map(|k| self.memory[k])
+            };
+            self.guess.push(match row.kind {
+                RowKind::ContactNormal(i) => recalled(i).map_or(0.0, |m| m.1),
+                RowKind::ContactTangent(i) => recalled(i).map_or(0.0, |m| m.2),
+                _ => 0.0,
+            });
         }
     }
 
@@ -278,7 +315,11 @@ impl SimultaneousSolver {
             targets,
             &mut self.rows,
         );
+        if self.rows.len() > self.dense_row_limit {
+            self.remember();
+        }
         self.solve_rows(bodies, true);
+        self.guess.clear();
     }
 
     /// Solves the current rows and, if `apply`, applies their impulses. Islands up to
@@ -351,6 +392,14 @@ impl SimultaneousSolver {
         for row in &self.rows {
             for e in &row.ends {
                 scratch[e.body as usize] = bodies[e.body as usize];
+            }
+        }
+        if self.guess.len() == n {
+            for (k, row) in self.rows.iter().enumerate() {
+                if self.guess[k] != 0.0 {
+                    row.apply(scratch, self.guess[k]);
+                    self.x[k] = self.guess[k];
+                }
             }
         }
         // w_i = (row velocity now) + offset_i, where offset_i = b_i − (velocity at start).
