@@ -827,6 +827,13 @@ impl JointBlock {
                 }
             }
         }
+        // Redundant pins (a body pinned to the world twice, a closed loop) make K singular;
+        // a relative regularisation keeps the factor finite and the impulses bounded,
+        // changing each pin's velocity by at most 1e-9 of its scale.
+        let largest = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
+        for i in 0..2 * m {
+            k[(i, i)] += 1e-9 * largest;
+        }
         let Some(cholesky) = k.cholesky() else {
             return false;
         };
