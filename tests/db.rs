@@ -492,6 +492,30 @@ fn generated_monsters_give_errors_not_panics() {
     assert_eq!(p.location.map(|l| l.line), Some(2));
 }
 
+/// Every problem prints as one line (the CLI's promise), even when the name or the tag it
+/// quotes has a newline in it (found by the `xml_database` fuzz target: `</\n>`).
+#[test]
+fn problems_are_one_line_whatever_they_quote() {
+    let (_, problems, _dir) = load(&[
+        (FileKind::Bodies, b"</\n>"),
+        (
+            FileKind::Scenes,
+            b"<scenes><scene name=\"two&#10;lines&#13;\" gravitation=\"1\" friction=\"-1\"/></scenes>",
+        ),
+    ]);
+    assert_eq!(problems.len(), 2, "{problems:#?}");
+    for p in &problems {
+        let line = p.to_string();
+        assert!(!line.contains(['\n', '\r']), "{line:?}");
+    }
+    assert!(problems[0].message.contains("`</\\n>`"), "{}", problems[0]);
+    assert!(
+        problems[1].element.contains("two\\nlines\\r"),
+        "{}",
+        problems[1]
+    );
+}
+
 #[test]
 fn missing_files_are_empty_collections() {
     let (db, problems, _dir) = load(&[]);
