@@ -81,6 +81,10 @@ fn parse_solver(name: &str) -> Result<ContactSolver, String> {
     })
 }
 
+/// What opening the editor says in a build without the `app` feature.
+pub const NO_EDITOR: &str =
+    "robosim was built without the editor (feature `app`); use `robosim run` / `robosim check`";
+
 /// A failure to report: one line, exit code 2.
 pub struct Failure(pub String);
 

@@ -248,3 +248,22 @@ fn sleep_lets_the_stack_of_boxes_come_exactly_to_rest() {
         }
     }
 }
+
+/// A headless build (`cargo test --no-default-features`): opening the editor says why it
+/// cannot, in one line with exit code 2, while `check` still works.
+#[cfg(not(feature = "app"))]
+#[test]
+fn without_the_app_feature_the_editor_is_refused_clearly() {
+    for args in [&[][..], &["--db", "data"][..]] {
+        let out = robosim().args(args).output().unwrap();
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(
+            stderr.trim_end(),
+            format!("robosim: {}", robosim::cli::NO_EDITOR),
+            "{args:?}"
+        );
+    }
+    let out = robosim().args(["check", "--db", "data"]).output().unwrap();
+    assert!(out.status.success());
+}

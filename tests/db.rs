@@ -261,6 +261,34 @@ proptest! {
     }
 }
 
+/// Tabs and line breaks inside names and other texts survive save and load (found by the
+/// `xml_database` fuzz target: a name written `a&#10;b` was saved with a literal newline,
+/// which XML reads back as a space).
+#[test]
+fn line_breaks_and_tabs_in_texts_round_trip() {
+    let texts = ["a\nb", "tab\there", "cr\r\nlf", "&#10; <\"quoted\">"];
+    let mut model = Model::default();
+    for (i, text) in texts.iter().enumerate() {
+        model.bodies.push(BodyDef {
+            name: text.to_string(),
+            density: 1.0,
+            extra: vec![("note".into(), format!("{text} {i}"))],
+            ..BodyDef::default()
+        });
+        model.scenes.push(Scene {
+            name: format!("{text}{i}"),
+            solver: Some(text.to_string()),
+            ..Scene::default()
+        });
+    }
+    let dir = tempfile::tempdir().unwrap();
+    Database::new(model.clone())
+        .save_to(dir.path(), Overwrite::Never)
+        .unwrap();
+    let (loaded, _) = Database::load(dir.path());
+    assert_eq!(loaded.model, model);
+}
+
 /// One broken file: what it is, and what its error must say.
 struct Broken {
     file: &'static str,
@@ -490,6 +518,30 @@ fn generated_monsters_give_errors_not_panics() {
         .find(|p| p.message.contains("not valid UTF-8"))
         .expect("a UTF-8 error");
     assert_eq!(p.location.map(|l| l.line), Some(2));
+}
+
+/// Every problem prints as one line (the CLI's promise), even when the name or the tag it
+/// quotes has a newline in it (found by the `xml_database` fuzz target: `</\n>`).
+#[test]
+fn problems_are_one_line_whatever_they_quote() {
+    let (_, problems, _dir) = load(&[
+        (FileKind::Bodies, b"</\n>"),
+        (
+            FileKind::Scenes,
+            b"<scenes><scene name=\"two&#10;lines&#13;\" gravitation=\"1\" friction=\"-1\"/></scenes>",
+        ),
+    ]);
+    assert_eq!(problems.len(), 2, "{problems:#?}");
+    for p in &problems {
+        let line = p.to_string();
+        assert!(!line.contains(['\n', '\r']), "{line:?}");
+    }
+    assert!(problems[0].message.contains("`</\\n>`"), "{}", problems[0]);
+    assert!(
+        problems[1].element.contains("two\\nlines\\r"),
+        "{}",
+        problems[1]
+    );
 }
 
 #[test]

@@ -223,3 +223,42 @@ fn joints_solved_with_contacts_hold_tighter_than_separate_passes() {
         );
     }
 }
+
+/// What `db::check` reports but the editor still simulates must be refused here, not
+/// handed to `pe`: a joint motor with a negative maxTorque made the first step panic
+/// (found with the `xml_database` fuzz target's checks), and a negative friction made
+/// friction push bodies along.
+#[test]
+fn values_the_engine_cannot_take_are_refused_with_an_error() {
+    let scene = "car on terrain";
+    let error = |model: &Model| match Simulation::new(model, scene, None, None) {
+        Ok(_) => panic!("the scene was accepted"),
+        Err(e) => e.to_string(),
+    };
+    let mut model = model();
+    let car = model.robots.iter_mut().find(|r| r.name == "car").unwrap();
+    car.joints[0].motor.as_mut().unwrap().max_torque = -1.0;
+    let message = error(&model);
+    assert!(message.contains("maxTorque -1"), "{message}");
+
+    for friction in [-0.5, f64::NAN] {
+        let mut model = self::model();
+        model
+            .scenes
+            .iter_mut()
+            .find(|s| s.name == scene)
+            .unwrap()
+            .friction = friction;
+        let message = error(&model);
+        assert!(message.contains("friction"), "{message}");
+    }
+    let mut model = self::model();
+    model
+        .scenes
+        .iter_mut()
+        .find(|s| s.name == scene)
+        .unwrap()
+        .gravitation = f64::INFINITY;
+    let message = error(&model);
+    assert!(message.contains("gravitation"), "{message}");
+}

@@ -22,14 +22,31 @@ pub struct Problem {
     pub message: String,
 }
 
+/// `text` on one line: control characters (a newline in a name, in a tag that the XML
+/// parser quotes) written as escapes, so that a problem always prints as one line.
+fn one_line(text: String) -> String {
+    if !text.chars().any(char::is_control) {
+        return text;
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 impl Problem {
     pub fn error(file: &str, element: &str, message: impl Into<String>) -> Self {
         Self {
             severity: Severity::Error,
             file: file.to_string(),
             location: None,
-            element: element.to_string(),
-            message: message.into(),
+            element: one_line(element.to_string()),
+            message: one_line(message.into()),
         }
     }
 

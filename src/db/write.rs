@@ -15,6 +15,20 @@ pub fn number(v: f64) -> String {
     }
 }
 
+/// `value` escaped for a double-quoted attribute. Tabs and line breaks are written as
+/// character references: a reader turns literal ones into spaces (XML's attribute-value
+/// normalization), so a name with a newline would not load back the same.
+fn attribute_value(value: &str) -> String {
+    let escaped = escape(value);
+    if !escaped.contains(['\t', '\n', '\r']) {
+        return escaped.into_owned();
+    }
+    escaped
+        .replace('\t', "&#9;")
+        .replace('\n', "&#10;")
+        .replace('\r', "&#13;")
+}
+
 struct Tag {
     text: String,
 }
@@ -27,7 +41,7 @@ impl Tag {
     }
 
     fn text(mut self, key: &str, value: &str) -> Self {
-        let _ = write!(self.text, " {key}=\"{}\"", escape(value));
+        let _ = write!(self.text, " {key}=\"{}\"", attribute_value(value));
         self
     }
 

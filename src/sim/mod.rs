@@ -167,6 +167,20 @@ impl Simulation {
     }
 
     fn populate(&mut self, scene: &Scene) -> Result<(), String> {
+        // The checks `pe` leaves to its caller (the editor simulates a model whatever its
+        // problems, so what `db::check` reports must not reach the engine either).
+        if !(scene.friction.is_finite() && scene.friction >= 0.0) {
+            return Err(format!(
+                "friction {} is not a finite number ≥ 0",
+                scene.friction
+            ));
+        }
+        if !scene.gravitation.is_finite() {
+            return Err(format!(
+                "gravitation {} is not a finite number",
+                scene.gravitation
+            ));
+        }
         self.world.friction = scene.friction;
         self.world.settings.contact_solver = self.solver;
         let model = self.model.clone();
@@ -231,9 +245,17 @@ impl Simulation {
                 def.collide_connected = j.collide;
                 let mut motor_window = None;
                 if let Some(m) = &j.motor {
+                    let speed = m.angular / self.dt;
+                    if !(m.max_torque.is_finite() && m.max_torque >= 0.0 && speed.is_finite()) {
+                        return Err(format!(
+                            "{id}: the motor needs a finite angular and a finite maxTorque ≥ 0 \
+                             (angular {}, maxTorque {})",
+                            m.angular, m.max_torque
+                        ));
+                    }
                     def.motor = Some(JointMotor {
                         enabled: (m.time0..m.time1).contains(&0),
-                        ..JointMotor::new(m.angular / self.dt, m.max_torque)
+                        ..JointMotor::new(speed, m.max_torque)
                     });
                     motor_window = Some((m.time0, m.time1, m.angular));
                 }
