@@ -262,3 +262,45 @@ fn values_the_engine_cannot_take_are_refused_with_an_error() {
     let message = error(&model);
     assert!(message.contains("gravitation"), "{message}");
 }
+
+#[test]
+fn absurd_magnitudes_are_refused_by_check_and_by_the_simulation() {
+    // Found by the xml_database fuzz target: finite but absurd numbers passed the checks
+    // and the first step overflowed to infinity.
+    let scene = "housenka on the floor";
+    let mutations: [(&str, fn(&mut Model)); 3] = [
+        ("gravitation", |m| {
+            m.scenes.iter_mut().for_each(|s| s.gravitation = 1e308)
+        }),
+        ("startTorque", |m| {
+            for r in &mut m.robots {
+                for b in &mut r.bodies {
+                    for f in &mut b.motors {
+                        f.start_torque = 1e300;
+                    }
+                }
+            }
+        }),
+        ("density", |m| {
+            m.bodies.iter_mut().for_each(|b| b.density = 1e200)
+        }),
+    ];
+    for (what, mutate) in mutations {
+        let mut model = model();
+        mutate(&mut model);
+        let problems = robosim::db::check(&model, |k| format!("{k:?}.xml"));
+        let found = problems
+            .iter()
+            .find(|p| p.to_string().contains(what) && p.to_string().contains("beyond"));
+        assert!(
+            found.is_some(),
+            "{what}: no problem reported in {problems:#?}"
+        );
+        let refused = Simulation::new(&model, scene, None, None);
+        let message = refused.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(
+            message.contains(what) && message.contains("beyond"),
+            "{what}: the simulation said {message:?}"
+        );
+    }
+}

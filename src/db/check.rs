@@ -11,6 +11,29 @@ use std::collections::BTreeMap;
 /// making sense (SPEC §6.1 recommends 0.01–0.1; we allow a decade either side).
 pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
 
+/// The largest magnitude each kind of number may have. They are far beyond anything a
+/// robot needs (issue 9's extreme-but-legal input: coordinates of 1e6, density ratios of
+/// 1e6, torques of 1e12) and far below where a step overflows (the fuzzer found that a
+/// gravitation of 1e308 or a startTorque of 1e300 passed the finite checks and turned the
+/// first step to infinity).
+pub mod limits {
+    pub const COORDINATE: f64 = 1e9;
+    pub const ANGLE: f64 = 1e6;
+    pub const DENSITY: f64 = 1e12;
+    pub const FRICTION: f64 = 1e6;
+    pub const GRAVITATION: f64 = 1e9;
+    pub const TORQUE: f64 = 1e15;
+    /// Motor speed, radians per step.
+    pub const ANGULAR: f64 = 1e6;
+    /// A body motor's ramp, fraction of startTorque per step.
+    pub const INCREASE: f64 = 1e6;
+}
+
+/// "`what` {value} is larger than {limit}" when `value` exceeds `limit` in magnitude.
+pub fn beyond(what: &str, value: f64, limit: f64) -> Option<String> {
+    (value.abs() > limit).then(|| format!("{what} {value:e} is beyond ±{limit:e}"))
+}
+
 /// All problems of `model`, whose files are named by `file`.
 pub fn check(model: &Model, file: impl Fn(FileKind) -> String) -> Vec<Problem> {
     let mut out = Vec::new();
@@ -103,6 +126,22 @@ fn check_body(body: &BodyDef, file: &str, out: &mut Vec<Problem>) {
     if let Err(e) = polygon(body) {
         error(format!("the vertices are not a usable convex polygon: {e}"));
     }
+    let vertices = body
+        .vertices
+        .iter()
+        .flatten()
+        .map(|&v| ("vertex coordinate", v, limits::COORDINATE));
+    let numbers = [
+        ("density", body.density, limits::DENSITY),
+        ("friction", body.friction.unwrap_or(0.0), limits::FRICTION),
+    ];
+    if let Some(message) = numbers
+        .into_iter()
+        .chain(vertices)
+        .find_map(|(what, v, limit)| beyond(what, v, limit))
+    {
+        error(message);
+    }
 }
 
 fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>) {
@@ -111,6 +150,16 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
     for (i, b) in robot.bodies.iter().enumerate() {
         let p = &b.placement;
         let what = format!("<body> \"{}\" in robot \"{name}\"", clip(&p.alias));
+        for message in [
+            beyond("x", p.x, limits::COORDINATE),
+            beyond("y", p.y, limits::COORDINATE),
+            beyond("orientation", p.orientation, limits::ANGLE),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            out.push(Problem::error(file, &what, message).at(p.location));
+        }
         if aliases.insert(p.alias.trim(), i).is_some() {
             out.push(
                 Problem::error(file, &what, "the alias is already used in this robot")
@@ -134,6 +183,17 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                     Problem::warning(file, &what, "time1 is before time0: the motor never runs")
                         .at(m.location),
                 );
+            }
+            for message in [
+                beyond("angular", m.angular, limits::ANGULAR),
+                beyond("startTorque", m.start_torque, limits::TORQUE),
+                beyond("maxTorque", m.max_torque, limits::TORQUE),
+                beyond("increase", m.increase, limits::INCREASE),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                out.push(Problem::error(file, &what, message).at(m.location));
             }
             if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
                 out.push(
@@ -172,13 +232,29 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                 );
             }
         }
-        if let Some(m) = &j.motor
-            && m.max_torque < 0.0
+        if let Some(m) = &j.motor {
+            let motor = format!("<motor> of {what}");
+            if m.max_torque < 0.0 {
+                out.push(Problem::error(file, &motor, "maxTorque must be ≥ 0").at(m.location));
+            }
+            for message in [
+                beyond("angular", m.angular, limits::ANGULAR),
+                beyond("maxTorque", m.max_torque, limits::TORQUE),
+            ]
+            .into_iter()
+            .flatten()
+            {
+                out.push(Problem::error(file, &motor, message).at(m.location));
+            }
+        }
+        for message in [
+            beyond("anchor coordinate", j.anchor_ax, limits::COORDINATE),
+            beyond("anchor coordinate", j.anchor_ay, limits::COORDINATE),
+        ]
+        .into_iter()
+        .flatten()
         {
-            out.push(
-                Problem::error(file, &format!("<motor> of {what}"), "maxTorque must be ≥ 0")
-                    .at(m.location),
-            );
+            out.push(Problem::error(file, &what, message).at(j.location));
         }
         let (Some(a), Some(b)) = (a, b) else { continue };
         if a == b {
@@ -243,6 +319,15 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
     if scene.friction < 0.0 {
         error(format!("friction {} is negative", scene.friction));
     }
+    for message in [
+        beyond("friction", scene.friction, limits::FRICTION),
+        beyond("gravitation", scene.gravitation, limits::GRAVITATION),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        error(message);
+    }
     if let Some(h) = scene.timestep
         && !(TIMESTEP_RANGE.0..=TIMESTEP_RANGE.1).contains(&h)
     {
@@ -261,6 +346,17 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
         ));
     }
     for r in &scene.robots {
+        for message in [
+            beyond("x", r.x, limits::COORDINATE),
+            beyond("y", r.y, limits::COORDINATE),
+            beyond("orientation", r.orientation, limits::ANGLE),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            let what = format!("<robot> in scene \"{}\"", clip(&scene.name));
+            out.push(Problem::error(file, &what, message).at(r.location));
+        }
         if model.robot(&r.source).is_none() {
             out.push(
                 Problem::error(
@@ -282,6 +378,16 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             clip(&b.alias),
             clip(&scene.name)
         );
+        for message in [
+            beyond("x", b.x, limits::COORDINATE),
+            beyond("y", b.y, limits::COORDINATE),
+            beyond("orientation", b.orientation, limits::ANGLE),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            out.push(Problem::error(file, &what, message).at(b.location));
+        }
         if aliases.insert(b.alias.trim(), ()).is_some() {
             out.push(
                 Problem::error(file, &what, "the alias is already used in this scene")

@@ -3,7 +3,7 @@
 
 pub mod trace;
 
-use crate::db;
+use crate::db::{self, beyond, limits};
 use crate::model::{Model, Placement, Scene};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
 
@@ -148,6 +148,16 @@ impl Simulation {
             .body(&placement.source)
             .ok_or_else(|| format!("{id}: source \"{}\" is not a body", placement.source))?;
         let polygon = db::polygon(def).map_err(|e| format!("{id}: body \"{}\": {e}", def.name))?;
+        let numbers = [
+            ("density", def.density, limits::DENSITY),
+            ("friction", def.friction.unwrap_or(0.0), limits::FRICTION),
+            ("x", at.0.x, limits::COORDINATE),
+            ("y", at.0.y, limits::COORDINATE),
+            ("orientation", at.1, limits::ANGLE),
+        ];
+        if let Some(message) = numbers.iter().find_map(|&(w, v, l)| beyond(w, v, l)) {
+            return Err(format!("{id}: {message}"));
+        }
         let mut body = BodyDef::new(polygon, def.density)
             .restitution(def.cor)
             .at(at.0, at.1);
@@ -181,6 +191,14 @@ impl Simulation {
                 scene.gravitation
             ));
         }
+        for (what, value, limit) in [
+            ("friction", scene.friction, limits::FRICTION),
+            ("gravitation", scene.gravitation, limits::GRAVITATION),
+        ] {
+            if let Some(message) = beyond(what, value, limit) {
+                return Err(message);
+            }
+        }
         self.world.friction = scene.friction;
         self.world.settings.contact_solver = self.solver;
         let model = self.model.clone();
@@ -198,6 +216,15 @@ impl Simulation {
                 let handle =
                     self.add_body(id.clone(), placed_by, p, compose(frame, placement_frame(p)))?;
                 for m in &b.motors {
+                    let numbers = [
+                        ("angular", m.angular, limits::ANGULAR),
+                        ("startTorque", m.start_torque, limits::TORQUE),
+                        ("maxTorque", m.max_torque, limits::TORQUE),
+                        ("increase", m.increase, limits::INCREASE),
+                    ];
+                    if let Some(message) = numbers.iter().find_map(|&(w, v, l)| beyond(w, v, l)) {
+                        return Err(format!("{id}: motor {message}"));
+                    }
                     let motor = pe::BodyMotor::new(
                         m.time0,
                         m.time1,
@@ -245,6 +272,14 @@ impl Simulation {
                 def.collide_connected = j.collide;
                 let mut motor_window = None;
                 if let Some(m) = &j.motor {
+                    for (what, value, limit) in [
+                        ("angular", m.angular, limits::ANGULAR),
+                        ("maxTorque", m.max_torque, limits::TORQUE),
+                    ] {
+                        if let Some(message) = beyond(what, value, limit) {
+                            return Err(format!("{id}: motor {message}"));
+                        }
+                    }
                     let speed = m.angular / self.dt;
                     if !(m.max_torque.is_finite() && m.max_torque >= 0.0 && speed.is_finite()) {
                         return Err(format!(
