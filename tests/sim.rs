@@ -268,7 +268,8 @@ fn absurd_magnitudes_are_refused_by_check_and_by_the_simulation() {
     // Found by the xml_database fuzz target: finite but absurd numbers passed the checks
     // and the first step overflowed to infinity.
     let scene = "housenka on the floor";
-    let mutations: [(&str, fn(&mut Model)); 3] = [
+    type Mutation = (&'static str, fn(&mut Model));
+    let mutations: [Mutation; 3] = [
         ("gravitation", |m| {
             m.scenes.iter_mut().for_each(|s| s.gravitation = 1e308)
         }),
