@@ -32,6 +32,8 @@ pub struct SoftSettings {
     pub joint_damping_ratio: f64,
     /// The fastest a soft contact pushes overlapping bodies apart (length units / s).
     pub max_push_speed: f64,
+    /// The fastest a soft pin pulls its anchors together (length units / s).
+    pub joint_push_speed: f64,
 }
 
 impl SoftSettings {
@@ -43,6 +45,10 @@ impl SoftSettings {
             joint_hertz: 60.0,
             joint_damping_ratio: 2.0,
             max_push_speed: 3.0 * length_scale,
+            // Far faster than contacts: a loaded net of pins (100 × 100, hanging from
+            // seven) opened to 16 m with pins capped at 3 length scales per second, and
+            // to 0.49 m (as Box2D v3's, which has no cap) at 100.
+            joint_push_speed: 100.0 * length_scale,
         }
     }
 }
@@ -205,15 +211,9 @@ impl SoftStepSolver {
         for _ in 0..settings.substeps {
             self.integrate_velocities(accelerations, h);
             self.warm_start();
-            self.solve(h, &contact_soft, &joint_soft, settings.max_push_speed, true);
+            self.solve(h, &contact_soft, &joint_soft, settings, true);
             self.integrate_positions(h);
-            self.solve(
-                h,
-                &contact_soft,
-                &joint_soft,
-                settings.max_push_speed,
-                false,
-            );
+            self.solve(h, &contact_soft, &joint_soft, settings, false);
             // Warm starting re-applies the accumulated impulse in every substep, so the
             // step's total is the sum of the substeps' accumulated values.
             for j in &mut self.joints {
@@ -464,9 +464,10 @@ impl SoftStepSolver {
         h: f64,
         contact_soft: &Softness,
         joint_soft: &Softness,
-        max_push: f64,
+        settings: &SoftSettings,
         use_bias: bool,
     ) {
+        let (max_push, joint_push) = (settings.max_push_speed, settings.joint_push_speed);
         for j in self.joints.iter_mut() {
             solve_motor(&mut self.bodies, j, h);
         }
@@ -476,10 +477,10 @@ impl SoftStepSolver {
             let solved = (2..=DIRECT_JOINT_LIMIT).contains(&island.len())
                 && self
                     .block
-                    .solve(&mut self.bodies, island, joint_soft, max_push, use_bias);
+                    .solve(&mut self.bodies, island, joint_soft, joint_push, use_bias);
             if !solved {
                 for j in island.iter_mut() {
-                    solve_joint(&mut self.bodies, j, joint_soft, max_push, use_bias);
+                    solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
                 }
             }
         }
@@ -827,14 +828,28 @@ impl JointBlock {
                 }
             }
         }
-        // Redundant pins (a body pinned to the world twice, a closed loop) make K singular;
-        // a relative regularisation keeps the factor finite and the impulses bounded,
-        // changing each pin's velocity by at most 1e-9 of its scale.
+        // Redundant pins (a body pinned to the world twice, a closed loop) make K singular:
+        // its factor then has a pivot at round-off level and the impulses blow up. Only
+        // then is K regularised (by 1e-9 of its largest diagonal, which keeps the impulses
+        // bounded): a heavy chain's K is ill-conditioned but regular, and even that much
+        // regularisation doubled its gap.
         let largest = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
-        for i in 0..2 * m {
-            k[(i, i)] += 1e-9 * largest;
-        }
-        let Some(cholesky) = k.cholesky() else {
+        let original = k.clone();
+        let factor = k.cholesky().filter(|c| {
+            let l = c.l_dirty();
+            (0..2 * m).all(|i| l[(i, i)] * l[(i, i)] > 1e-12 * largest)
+        });
+        let factor = match factor {
+            Some(f) => Some(f),
+            None => {
+                let mut k = original;
+                for i in 0..2 * m {
+                    k[(i, i)] += 1e-9 * largest;
+                }
+                k.cholesky()
+            }
+        };
+        let Some(cholesky) = factor else {
             return false;
         };
         cholesky.solve_mut(&mut self.rhs);
