@@ -21,11 +21,16 @@ pub enum BodyError {
     BadDensity(f64),
     #[error("restitution (cor) must lie in [0, 1], got {0}")]
     BadRestitution(f64),
-    #[error("friction must be a finite number ≥ 0, got {0}")]
+    #[error("friction must be a number in [0, 1e6], got {0}")]
     BadFriction(f64),
     #[error("position and angle must be finite")]
     NonFinitePlacement,
 }
+
+/// The largest friction coefficient a body or world may have: far beyond any material,
+/// and far below where μ times an impulse overflows (a μ of 1e300 turned a sliding
+/// contact's friction bound to infinity and its impulse to NaN).
+pub const MAX_FRICTION: f64 = 1e6;
 
 /// Everything needed to make a body: shape, material and where it starts.
 #[derive(Debug, Clone)]
@@ -122,7 +127,7 @@ impl Body {
             return Err(BodyError::BadRestitution(def.restitution));
         }
         if let Some(mu) = def.friction
-            && (!mu.is_finite() || mu < 0.0)
+            && !(0.0..=MAX_FRICTION).contains(&mu)
         {
             return Err(BodyError::BadFriction(mu));
         }

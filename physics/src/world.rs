@@ -139,7 +139,7 @@ pub enum StepError {
     BadTimeStep(f64),
     #[error("gravity must be finite, got ({0}, {1})")]
     BadGravity(f64, f64),
-    #[error("the world's friction must be a finite number ≥ 0, got {0}")]
+    #[error("the world's friction must be a number in [0, 1e6], got {0}")]
     BadFriction(f64),
 }
 
@@ -435,7 +435,7 @@ impl World {
         if !(self.gravity.x.is_finite() && self.gravity.y.is_finite()) {
             return Err(StepError::BadGravity(self.gravity.x, self.gravity.y));
         }
-        if !(self.friction.is_finite() && self.friction >= 0.0) {
+        if !(0.0..=crate::body::MAX_FRICTION).contains(&self.friction) {
             return Err(StepError::BadFriction(self.friction));
         }
         self.advance(dt);

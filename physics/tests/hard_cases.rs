@@ -632,8 +632,12 @@ fn numbers_that_would_poison_the_state_are_refused() {
     w.gravity = Vec2::new(0.0, f64::NAN);
     assert!(matches!(w.try_step(H), Err(StepError::BadGravity(..))));
     w.gravity = Vec2::new(0.0, 10.0);
-    w.friction = -1.0;
-    assert!(matches!(w.try_step(H), Err(StepError::BadFriction(_))));
+    for mu in [-1.0, 1e300, f64::NAN] {
+        w.friction = mu;
+        assert!(matches!(w.try_step(H), Err(StepError::BadFriction(_))));
+        let def = BodyDef::new(ConvexPolygon::rectangle(1.0, 1.0).unwrap(), 1.0).friction(mu);
+        assert!(w.add_body(def).is_err(), "a body with friction {mu}");
+    }
     let after: Vec<_> = w.bodies().map(|(_, b)| (b.position, b.velocity)).collect();
     assert_eq!(before, after);
     assert_eq!(w.step_count(), 0);
