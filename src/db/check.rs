@@ -34,6 +34,14 @@ pub fn beyond(what: &str, value: f64, limit: f64) -> Option<String> {
     (value.abs() > limit).then(|| format!("{what} {value:e} is beyond ±{limit:e}"))
 }
 
+/// The messages of every `(what, value, limit)` whose value is beyond its limit.
+pub fn beyond_all(numbers: &[(&str, f64, f64)]) -> Vec<String> {
+    numbers
+        .iter()
+        .filter_map(|&(what, value, limit)| beyond(what, value, limit))
+        .collect()
+}
+
 /// All problems of `model`, whose files are named by `file`.
 pub fn check(model: &Model, file: impl Fn(FileKind) -> String) -> Vec<Problem> {
     let mut out = Vec::new();
@@ -150,14 +158,11 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
     for (i, b) in robot.bodies.iter().enumerate() {
         let p = &b.placement;
         let what = format!("<body> \"{}\" in robot \"{name}\"", clip(&p.alias));
-        for message in [
-            beyond("x", p.x, limits::COORDINATE),
-            beyond("y", p.y, limits::COORDINATE),
-            beyond("orientation", p.orientation, limits::ANGLE),
-        ]
-        .into_iter()
-        .flatten()
-        {
+        for message in beyond_all(&[
+            ("x", p.x, limits::COORDINATE),
+            ("y", p.y, limits::COORDINATE),
+            ("orientation", p.orientation, limits::ANGLE),
+        ]) {
             out.push(Problem::error(file, &what, message).at(p.location));
         }
         if aliases.insert(p.alias.trim(), i).is_some() {
@@ -184,15 +189,12 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                         .at(m.location),
                 );
             }
-            for message in [
-                beyond("angular", m.angular, limits::ANGULAR),
-                beyond("startTorque", m.start_torque, limits::TORQUE),
-                beyond("maxTorque", m.max_torque, limits::TORQUE),
-                beyond("increase", m.increase, limits::INCREASE),
-            ]
-            .into_iter()
-            .flatten()
-            {
+            for message in beyond_all(&[
+                ("angular", m.angular, limits::ANGULAR),
+                ("startTorque", m.start_torque, limits::TORQUE),
+                ("maxTorque", m.max_torque, limits::TORQUE),
+                ("increase", m.increase, limits::INCREASE),
+            ]) {
                 out.push(Problem::error(file, &what, message).at(m.location));
             }
             if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
@@ -237,23 +239,17 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
             if m.max_torque < 0.0 {
                 out.push(Problem::error(file, &motor, "maxTorque must be ≥ 0").at(m.location));
             }
-            for message in [
-                beyond("angular", m.angular, limits::ANGULAR),
-                beyond("maxTorque", m.max_torque, limits::TORQUE),
-            ]
-            .into_iter()
-            .flatten()
-            {
+            for message in beyond_all(&[
+                ("angular", m.angular, limits::ANGULAR),
+                ("maxTorque", m.max_torque, limits::TORQUE),
+            ]) {
                 out.push(Problem::error(file, &motor, message).at(m.location));
             }
         }
-        for message in [
-            beyond("anchor coordinate", j.anchor_ax, limits::COORDINATE),
-            beyond("anchor coordinate", j.anchor_ay, limits::COORDINATE),
-        ]
-        .into_iter()
-        .flatten()
-        {
+        for message in beyond_all(&[
+            ("anchor coordinate", j.anchor_ax, limits::COORDINATE),
+            ("anchor coordinate", j.anchor_ay, limits::COORDINATE),
+        ]) {
             out.push(Problem::error(file, &what, message).at(j.location));
         }
         let (Some(a), Some(b)) = (a, b) else { continue };
@@ -319,13 +315,10 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
     if scene.friction < 0.0 {
         error(format!("friction {} is negative", scene.friction));
     }
-    for message in [
-        beyond("friction", scene.friction, limits::FRICTION),
-        beyond("gravitation", scene.gravitation, limits::GRAVITATION),
-    ]
-    .into_iter()
-    .flatten()
-    {
+    for message in beyond_all(&[
+        ("friction", scene.friction, limits::FRICTION),
+        ("gravitation", scene.gravitation, limits::GRAVITATION),
+    ]) {
         error(message);
     }
     if let Some(h) = scene.timestep
@@ -346,15 +339,12 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
         ));
     }
     for r in &scene.robots {
-        for message in [
-            beyond("x", r.x, limits::COORDINATE),
-            beyond("y", r.y, limits::COORDINATE),
-            beyond("orientation", r.orientation, limits::ANGLE),
-        ]
-        .into_iter()
-        .flatten()
-        {
-            let what = format!("<robot> in scene \"{}\"", clip(&scene.name));
+        let what = format!("<robot> in scene \"{}\"", clip(&scene.name));
+        for message in beyond_all(&[
+            ("x", r.x, limits::COORDINATE),
+            ("y", r.y, limits::COORDINATE),
+            ("orientation", r.orientation, limits::ANGLE),
+        ]) {
             out.push(Problem::error(file, &what, message).at(r.location));
         }
         if model.robot(&r.source).is_none() {
@@ -378,14 +368,11 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             clip(&b.alias),
             clip(&scene.name)
         );
-        for message in [
-            beyond("x", b.x, limits::COORDINATE),
-            beyond("y", b.y, limits::COORDINATE),
-            beyond("orientation", b.orientation, limits::ANGLE),
-        ]
-        .into_iter()
-        .flatten()
-        {
+        for message in beyond_all(&[
+            ("x", b.x, limits::COORDINATE),
+            ("y", b.y, limits::COORDINATE),
+            ("orientation", b.orientation, limits::ANGLE),
+        ]) {
             out.push(Problem::error(file, &what, message).at(b.location));
         }
         if aliases.insert(b.alias.trim(), ()).is_some() {

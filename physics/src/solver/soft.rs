@@ -371,35 +371,13 @@ impl SoftStepSolver {
     /// Orders `joints` island by island (pins linked through moving bodies) and records
     /// each island's range.
     fn group_joints(&mut self) {
-        let bodies = &self.bodies;
-        let dynamic =
-            |i: u32| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0;
-        let joints = &self.joints;
-        group_by_island(
-            joints.len(),
-            bodies.len(),
-            |i| (joints[i].a, joints[i].b),
-            dynamic,
-            &mut self.island_uf,
-            &mut self.grouped,
+        sort_into_islands(
+            &mut self.joints,
+            |j| (j.a, j.b),
+            &self.bodies,
+            (&mut self.island_uf, &mut self.grouped),
+            &mut self.joint_islands,
         );
-        let ordered: Vec<SoftJoint> = self
-            .grouped
-            .iter()
-            .map(|&(_, i)| joints[i as usize])
-            .collect();
-        self.joints = ordered;
-        self.joint_islands.clear();
-        let mut start = 0;
-        while start < self.grouped.len() {
-            let root = self.grouped[start].0;
-            let len = self.grouped[start..]
-                .iter()
-                .take_while(|g| g.0 == root)
-                .count();
-            self.joint_islands.push((start, start + len));
-            start += len;
-        }
     }
 
     fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
@@ -765,6 +743,37 @@ fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
     }
 }
 
+/// Reorders `items` island by island (linked through moving bodies; each island keeps its
+/// items' order) and fills `ranges` with each island's index range.
+fn sort_into_islands<T: Copy>(
+    items: &mut Vec<T>,
+    ends: impl Fn(&T) -> (u32, u32),
+    bodies: &[SoftBody],
+    (uf, grouped): (&mut UnionFind, &mut Vec<(u32, u32)>),
+    ranges: &mut Vec<(usize, usize)>,
+) {
+    let dynamic =
+        |i: u32| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0;
+    group_by_island(
+        items.len(),
+        bodies.len(),
+        |i| ends(&items[i]),
+        dynamic,
+        uf,
+        grouped,
+    );
+    let ordered: Vec<T> = grouped.iter().map(|&(_, i)| items[i as usize]).collect();
+    *items = ordered;
+    ranges.clear();
+    let mut start = 0;
+    while start < grouped.len() {
+        let root = grouped[start].0;
+        let len = grouped[start..].iter().take_while(|g| g.0 == root).count();
+        ranges.push((start, start + len));
+        start += len;
+    }
+}
+
 /// A pin's current arms, its anchors' relative velocity plus the soft bias towards a
 /// closed gap, and the softness scales for this pass.
 fn pin_target(
@@ -940,6 +949,7 @@ struct ContactLcp {
     islands: Vec<(usize, usize, usize)>,
     /// Every contact island's point range, and whether it is solved as an LCP.
     all_islands: Vec<(usize, usize, bool)>,
+    ranges: Vec<(usize, usize)>,
     /// Row-major J M⁻¹ Jᵀ of each island: rows 2k (normal) and 2k + 1 (tangent) of point k.
     /// The anchors are fixed for the step, so it is built once per step.
     k: Vec<f64>,
@@ -968,30 +978,16 @@ impl ContactLcp {
         self.islands.clear();
         self.all_islands.clear();
         self.k.clear();
-        let dynamic =
-            |i: u32| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0;
-        group_by_island(
-            points.len(),
-            bodies.len(),
-            |i| (points[i].a, points[i].b),
-            dynamic,
-            &mut self.uf,
-            &mut self.grouped,
+        let mut ranges = std::mem::take(&mut self.ranges);
+        sort_into_islands(
+            points,
+            |p| (p.a, p.b),
+            bodies,
+            (&mut self.uf, &mut self.grouped),
+            &mut ranges,
         );
-        let ordered: Vec<PointConstraint> = self
-            .grouped
-            .iter()
-            .map(|&(_, i)| points[i as usize])
-            .collect();
-        *points = ordered;
-        let mut start = 0;
-        while start < self.grouped.len() {
-            let root = self.grouped[start].0;
-            let len = self.grouped[start..]
-                .iter()
-                .take_while(|g| g.0 == root)
-                .count();
-            let end = start + len;
+        for &(start, end) in &ranges {
+            let len = end - start;
             let (lightest, heaviest) = points[start..end]
                 .iter()
                 .flat_map(|p| [p.a, p.b])
@@ -1033,8 +1029,8 @@ impl ContactLcp {
                 }
                 self.islands.push((start, end, offset));
             }
-            start = end;
         }
+        self.ranges = ranges;
     }
 
     /// One pass over the small islands: totals x with w = K (x − x₀) + v − target, normals
