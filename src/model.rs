@@ -118,7 +118,7 @@ impl Robot {
     pub fn body(&self, alias: &str) -> Option<&RobotBody> {
         self.bodies
             .iter()
-            .find(|b| b.placement.alias == alias.trim())
+            .find(|b| b.placement.alias.trim() == alias.trim())
     }
 }
 
@@ -168,17 +168,18 @@ pub struct Model {
 }
 
 impl Model {
-    /// Looks a body definition up by name; whitespace around `name` is ignored
-    /// (the thesis's own example says `source=" housenka"`).
+    /// Looks a body definition up by name; whitespace around `name`, and around the stored
+    /// name, is ignored (the thesis's own example says `source=" housenka"`; a name written
+    /// `name=" box "` could otherwise never be referred to).
     pub fn body(&self, name: &str) -> Option<&BodyDef> {
-        self.bodies.iter().find(|b| b.name == name.trim())
+        self.bodies.iter().find(|b| b.name.trim() == name.trim())
     }
 
     pub fn robot(&self, name: &str) -> Option<&Robot> {
-        self.robots.iter().find(|r| r.name == name.trim())
+        self.robots.iter().find(|r| r.name.trim() == name.trim())
     }
 
     pub fn scene(&self, name: &str) -> Option<&Scene> {
-        self.scenes.iter().find(|s| s.name == name.trim())
+        self.scenes.iter().find(|s| s.name.trim() == name.trim())
     }
 }

@@ -723,3 +723,24 @@ fn a_database_is_dirty_only_between_an_edit_and_its_save() {
     assert!(!db.is_dirty());
     assert_eq!(Database::load(dir.path()).0.model, db.model);
 }
+
+#[test]
+fn names_with_surrounding_spaces_can_be_referred_to() {
+    // Found by the fuzzing helper: references were trimmed, stored names were not, so a
+    // body, robot or scene named " x " could never be found, while check (which compares
+    // names trimmed) raised nothing.
+    let (db, _) = Database::embedded();
+    let mut model = db.model;
+    let body = model.bodies[0].name.clone();
+    let robot = model.robots[0].name.clone();
+    let scene = model.scenes[0].name.clone();
+    model.bodies[0].name = format!(" {body}\t");
+    model.robots[0].name = format!("  {robot} ");
+    model.scenes[0].name = format!("{scene} ");
+    assert!(model.body(&body).is_some());
+    assert!(model.robot(&format!(" {robot}")).is_some());
+    assert!(model.scene(&scene).is_some());
+    let alias = model.robots[0].bodies[0].placement.alias.clone();
+    model.robots[0].bodies[0].placement.alias = format!(" {alias} ");
+    assert!(model.robots[0].body(&alias).is_some());
+}

@@ -140,7 +140,7 @@ pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDe
     let robot = model
         .robots
         .iter_mut()
-        .find(|r| r.name == robot_name.trim())
+        .find(|r| r.name.trim() == robot_name.trim())
         .expect("found above");
     robot.joints.push(joint.clone());
     Ok(joint)
