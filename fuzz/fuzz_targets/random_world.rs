@@ -149,14 +149,7 @@ fn body_motor(m: &Motor) -> BodyMotor {
 
 fn assert_finite(world: &World, step: usize) {
     for (handle, b) in world.bodies() {
-        let state = [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.angular_velocity,
-        ];
+        let state = b.state();
         assert!(
             state.iter().all(|v| v.is_finite()),
             "step {step}: body {} is not finite: position {:?}, angle {}, velocity {:?}, \

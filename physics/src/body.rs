@@ -225,6 +225,19 @@ impl Body {
             0.0
         }
     }
+    /// The body's motion as numbers: centroid x and y, angle, velocity x and y, angular
+    /// velocity (what a trace compares bit for bit, and what must stay finite).
+    pub fn state(&self) -> [f64; 6] {
+        [
+            self.position.x,
+            self.position.y,
+            self.angle,
+            self.velocity.x,
+            self.velocity.y,
+            self.angular_velocity,
+        ]
+    }
+
     /// Distance from the centroid to the farthest vertex.
     pub fn bounding_radius(&self) -> f64 {
         self.radius

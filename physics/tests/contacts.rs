@@ -267,16 +267,7 @@ fn separate_islands_do_not_influence_each_other() {
         w.bodies()
             .skip(skip)
             .take(4)
-            .flat_map(|(_, b)| {
-                [
-                    b.position.x,
-                    b.position.y,
-                    b.angle,
-                    b.velocity.x,
-                    b.velocity.y,
-                    b.angular_velocity,
-                ]
-            })
+            .flat_map(|(_, b)| b.state())
             .map(f64::to_bits)
             .collect()
     };

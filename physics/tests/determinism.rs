@@ -27,16 +27,7 @@ fn pile(solver: ContactSolver) -> World {
 fn state_bits(world: &World) -> Vec<u64> {
     world
         .bodies()
-        .flat_map(|(_, b)| {
-            [
-                b.position.x,
-                b.position.y,
-                b.angle,
-                b.velocity.x,
-                b.velocity.y,
-                b.angular_velocity,
-            ]
-        })
+        .flat_map(|(_, b)| b.state())
         .map(f64::to_bits)
         .collect()
 }

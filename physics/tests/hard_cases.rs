@@ -12,18 +12,9 @@ const SOLVERS: [ContactSolver; 3] = [
 ];
 
 fn finite(world: &World) -> bool {
-    world.bodies().all(|(_, b)| {
-        [
-            b.position.x,
-            b.position.y,
-            b.angle,
-            b.velocity.x,
-            b.velocity.y,
-            b.angular_velocity,
-        ]
-        .iter()
-        .all(|v| v.is_finite())
-    })
+    world
+        .bodies()
+        .all(|(_, b)| b.state().iter().all(|v| v.is_finite()))
 }
 
 #[test]
