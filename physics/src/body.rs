@@ -94,6 +94,8 @@ pub struct Body {
     /// The vertex frame's origin in body space (−centroid in the vertex frame).
     local_origin: Vec2,
     radius: f64,
+    /// Distance from the centroid to the nearest edge line (the polygon is convex).
+    inner_radius: f64,
     area: f64,
     density: f64,
     mass: f64,
@@ -147,12 +149,20 @@ impl Body {
             .map(|v| v - mp.centroid)
             .collect();
         let radius = local_vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let n = local_vertices.len();
+        let inner_radius = (0..n)
+            .map(|i| {
+                let (a, b) = (local_vertices[i], local_vertices[(i + 1) % n]);
+                crate::math::cross(b - a, -a).abs() / (b - a).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
         let (mass, inertia) = (def.density * mp.area, def.density * mp.second_moment);
         let inverse = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
         Ok(Self {
             local_vertices,
             local_origin: -mp.centroid,
             radius,
+            inner_radius,
             area: mp.area,
             density: def.density,
             mass,
@@ -236,6 +246,12 @@ impl Body {
             self.velocity.y,
             self.angular_velocity,
         ]
+    }
+
+    /// The radius of the largest circle about the centroid inside the body: a body moving
+    /// less than half this per step cannot pass through anything.
+    pub fn inner_radius(&self) -> f64 {
+        self.inner_radius
     }
 
     /// Distance from the centroid to the farthest vertex.

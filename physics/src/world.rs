@@ -476,23 +476,15 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
-        // The static bodies' outlines and bounds, once per step.
+        // The static bodies' outlines and bounds, built once per step when the first body
+        // needs them (most steps, none does).
         let mut obstacles = std::mem::take(&mut s.obstacles);
-        let mut count = 0;
-        for obstacle in self.bodies.iter().flatten().filter(|o| o.is_static()) {
-            if obstacles.len() == count {
-                obstacles.push((WorldPolygon::default(), Aabb::default()));
-            }
-            let (polygon, bounds) = &mut obstacles[count];
-            polygon.update(obstacle);
-            *bounds = polygon.aabb();
-            count += 1;
-        }
+        let mut count: Option<usize> = None;
         for i in 0..self.bodies.len() {
             let Some(body) = self.bodies[i].as_ref() else {
                 continue;
             };
-            if body.is_fixed() || count == 0 {
+            if body.is_fixed() {
                 continue;
             }
             let sweep = Sweep {
@@ -506,11 +498,25 @@ impl World {
             // contacts were found before the solve, for the motion they had then). Moving a
             // jointed body back opens its pins, so jointed bodies only when fast enough to
             // pass through something: a wheel rolling over terrain is the contacts' job.
-            let fast = 0.5 * inner_radius(body.local_vertices());
+            let fast = 0.5 * body.inner_radius();
             let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
             if motion <= if jointed { fast } else { fast.min(margin) } {
                 continue;
             }
+            let count = *count.get_or_insert_with(|| {
+                let statics = self.bodies.iter().flatten().filter(|o| o.is_static());
+                let mut n = 0;
+                for obstacle in statics {
+                    if obstacles.len() == n {
+                        obstacles.push((WorldPolygon::default(), Aabb::default()));
+                    }
+                    let (polygon, bounds) = &mut obstacles[n];
+                    polygon.update(obstacle);
+                    *bounds = polygon.aabb();
+                    n += 1;
+                }
+                n
+            });
             let swept = Aabb {
                 min: sweep.start.0.inf(&sweep.end.0),
                 max: sweep.start.0.sup(&sweep.end.0),
@@ -1225,18 +1231,4 @@ impl World {
             b.torque = 0.0;
         }
     }
-}
-
-/// The radius of the largest circle about the centroid inside a convex polygon: the
-/// nearest edge line's distance. A body moving less than half this per step cannot pass
-/// through anything.
-fn inner_radius(local: &[Vec2]) -> f64 {
-    let n = local.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (local[i], local[(i + 1) % n]);
-            let edge = b - a;
-            crate::math::cross(edge, -a).abs() / edge.norm()
-        })
-        .fold(f64::INFINITY, f64::min)
 }

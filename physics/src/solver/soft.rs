@@ -172,6 +172,8 @@ pub struct SoftStepSolver {
 struct JointBlock {
     arms: Vec<(Vec2, Vec2)>,
     k: DMatrix<f64>,
+    /// A copy of K, for the rare refactoring with regularisation (the factor consumes K).
+    unfactored: DMatrix<f64>,
     rhs: DVector<f64>,
 }
 
@@ -843,7 +845,8 @@ impl JointBlock {
         // bounded): a heavy chain's K is ill-conditioned but regular, and even that much
         // regularisation doubled its gap.
         let largest = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
-        let original = k.clone();
+        self.unfactored.resize_mut(2 * m, 2 * m, 0.0);
+        self.unfactored.copy_from(&k);
         let factor = k.cholesky().filter(|c| {
             let l = c.l_dirty();
             (0..2 * m).all(|i| l[(i, i)] * l[(i, i)] > 1e-12 * largest)
@@ -851,7 +854,7 @@ impl JointBlock {
         let factor = match factor {
             Some(f) => Some(f),
             None => {
-                let mut k = original;
+                let mut k = std::mem::replace(&mut self.unfactored, DMatrix::zeros(0, 0));
                 for i in 0..2 * m {
                     k[(i, i)] += 1e-9 * largest;
                 }
@@ -1079,10 +1082,8 @@ impl ContactLcp {
                 hi: &self.hi,
                 friction_index: Some(&self.friction_index),
             };
-            let mut totals = Vec::new();
-            std::mem::swap(&mut totals, &mut self.x);
-            let stats = self.solver.solve(&problem, &mut totals);
-            std::mem::swap(&mut totals, &mut self.x);
+            // The starting impulses are in `b` already; the solve overwrites `x`.
+            let stats = self.solver.solve(&problem, &mut self.x);
             if stats.method == LcpMethod::Rejected {
                 for p in island.iter_mut() {
                     solve_point(bodies, p, h, soft, max_push, use_bias);
