@@ -8,7 +8,7 @@ mod read;
 pub mod write;
 mod xml;
 
-pub use check::{TIMESTEP_RANGE, beyond, check, limits, outline_polygon, polygon};
+pub use check::{TIMESTEP_RANGE, beyond_all, check, limits, outline_polygon, polygon};
 pub use problem::{Problem, Severity};
 pub use xml::{MAX_DEPTH, clip};
 

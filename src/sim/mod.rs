@@ -3,7 +3,7 @@
 
 pub mod trace;
 
-use crate::db::{self, beyond, limits};
+use crate::db::{self, beyond_all, limits};
 use crate::model::{Model, Placement, Scene};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
 
@@ -155,7 +155,7 @@ impl Simulation {
             ("y", at.0.y, limits::COORDINATE),
             ("orientation", at.1, limits::ANGLE),
         ];
-        if let Some(message) = numbers.iter().find_map(|&(w, v, l)| beyond(w, v, l)) {
+        if let Some(message) = beyond_all(&numbers).into_iter().next() {
             return Err(format!("{id}: {message}"));
         }
         let mut body = BodyDef::new(polygon, def.density)
@@ -191,13 +191,14 @@ impl Simulation {
                 scene.gravitation
             ));
         }
-        for (what, value, limit) in [
+        if let Some(message) = beyond_all(&[
             ("friction", scene.friction, limits::FRICTION),
             ("gravitation", scene.gravitation, limits::GRAVITATION),
-        ] {
-            if let Some(message) = beyond(what, value, limit) {
-                return Err(message);
-            }
+        ])
+        .into_iter()
+        .next()
+        {
+            return Err(message);
         }
         self.world.friction = scene.friction;
         self.world.settings.contact_solver = self.solver;
@@ -222,7 +223,7 @@ impl Simulation {
                         ("maxTorque", m.max_torque, limits::TORQUE),
                         ("increase", m.increase, limits::INCREASE),
                     ];
-                    if let Some(message) = numbers.iter().find_map(|&(w, v, l)| beyond(w, v, l)) {
+                    if let Some(message) = beyond_all(&numbers).into_iter().next() {
                         return Err(format!("{id}: motor {message}"));
                     }
                     let motor = pe::BodyMotor::new(
@@ -272,13 +273,14 @@ impl Simulation {
                 def.collide_connected = j.collide;
                 let mut motor_window = None;
                 if let Some(m) = &j.motor {
-                    for (what, value, limit) in [
+                    if let Some(message) = beyond_all(&[
                         ("angular", m.angular, limits::ANGULAR),
                         ("maxTorque", m.max_torque, limits::TORQUE),
-                    ] {
-                        if let Some(message) = beyond(what, value, limit) {
-                            return Err(format!("{id}: motor {message}"));
-                        }
+                    ])
+                    .into_iter()
+                    .next()
+                    {
+                        return Err(format!("{id}: motor {message}"));
                     }
                     let speed = m.angular / self.dt;
                     if !(m.max_torque.is_finite() && m.max_torque >= 0.0 && speed.is_finite()) {
