@@ -241,25 +241,17 @@ fn values_the_engine_cannot_take_are_refused_with_an_error() {
     let message = error(&model);
     assert!(message.contains("maxTorque -1"), "{message}");
 
-    for friction in [-0.5, f64::NAN] {
+    // The default model with the scene changed by `change`.
+    let with_scene = |change: &dyn Fn(&mut robosim::model::Scene)| {
         let mut model = self::model();
+        change(model.scenes.iter_mut().find(|s| s.name == scene).unwrap());
         model
-            .scenes
-            .iter_mut()
-            .find(|s| s.name == scene)
-            .unwrap()
-            .friction = friction;
-        let message = error(&model);
+    };
+    for friction in [-0.5, f64::NAN] {
+        let message = error(&with_scene(&|s| s.friction = friction));
         assert!(message.contains("friction"), "{message}");
     }
-    let mut model = self::model();
-    model
-        .scenes
-        .iter_mut()
-        .find(|s| s.name == scene)
-        .unwrap()
-        .gravitation = f64::INFINITY;
-    let message = error(&model);
+    let message = error(&with_scene(&|s| s.gravitation = f64::INFINITY));
     assert!(message.contains("gravitation"), "{message}");
 }
 
