@@ -160,62 +160,54 @@ impl LcpSolver {
     /// result if it is a solution: clamped values within their bounds, and `w` pointing
     /// the right way at each bound. False (nothing changed that matters) otherwise.
     fn solve_with_last_sets(&mut self) -> bool {
+        // The last pivoting left the factor of A_CC (its rows in `clamped`'s order), and
+        // A does not change between rounds: only the right-hand side does. A failure
+        // leaves x and w to `pivot`, which starts them afresh.
         let n = self.b.len();
-        let clamped: Vec<usize> = (0..n).filter(|&i| self.set[i] == Set::Clamped).collect();
-        let mut x = self.x.clone();
-        for (i, xi) in x.iter_mut().enumerate() {
+        for i in 0..n {
             match self.set[i] {
-                Set::Lower => *xi = self.lo[i],
-                Set::Upper => *xi = self.hi[i],
+                Set::Lower => self.x[i] = self.lo[i],
+                Set::Upper => self.x[i] = self.hi[i],
                 _ => {}
             }
         }
-        if !x.iter().all(|v| v.is_finite()) {
+        if !self.x.iter().all(|v| v.is_finite()) {
             return false;
         }
-        let m = clamped.len();
-        if m > 0 {
-            let mut a_cc = nalgebra::DMatrix::<f64>::zeros(m, m);
-            let mut rhs = nalgebra::DVector::<f64>::zeros(m);
-            for (r, &i) in clamped.iter().enumerate() {
-                for (c, &j) in clamped.iter().enumerate() {
-                    a_cc[(r, c)] = self.a[i * n + j];
-                }
-                a_cc[(r, r)] += REGULARISATION;
-                let bounded: f64 = (0..n)
-                    .filter(|&j| self.set[j] != Set::Clamped)
-                    .map(|j| self.a[i * n + j] * x[j])
-                    .sum();
-                rhs[r] = -self.b[i] - bounded;
-            }
-            let Some(factor) = a_cc.cholesky() else {
-                return false;
-            };
-            let solved = factor.solve(&rhs);
-            for (r, &i) in clamped.iter().enumerate() {
-                x[i] = solved[r];
-            }
+        self.rhs.clear();
+        for &i in &self.clamped {
+            let bounded: f64 = (0..n)
+                .filter(|&j| self.set[j] != Set::Clamped)
+                .map(|j| self.a[i * n + j] * self.x[j])
+                .sum();
+            self.rhs.push(-self.b[i] - bounded);
         }
-        let mut w = self.b.clone();
-        for (i, wi) in w.iter_mut().enumerate() {
-            *wi += (0..n).map(|j| self.a[i * n + j] * x[j]).sum::<f64>();
+        self.solve_factor();
+        for (k, &i) in self.clamped.iter().enumerate() {
+            self.x[i] = self.rhs[k];
+        }
+        for i in 0..n {
+            let row = &self.a[i * n..(i + 1) * n];
+            self.w[i] = self.b[i] + row.iter().zip(&self.x).map(|(a, x)| a * x).sum::<f64>();
         }
         let scale = 1.0 + self.b.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let tolerance = 1e-9 * scale;
         let valid = (0..n).all(|i| match self.set[i] {
-            Set::Clamped => x[i] >= self.lo[i] - tolerance && x[i] <= self.hi[i] + tolerance,
-            Set::Lower => w[i] >= -tolerance || self.lo[i] == self.hi[i],
-            Set::Upper => w[i] <= tolerance || self.lo[i] == self.hi[i],
+            Set::Clamped => {
+                self.x[i].is_finite()
+                    && self.x[i] >= self.lo[i] - tolerance
+                    && self.x[i] <= self.hi[i] + tolerance
+            }
+            Set::Lower => self.w[i] >= -tolerance || self.lo[i] == self.hi[i],
+            Set::Upper => self.w[i] <= tolerance || self.lo[i] == self.hi[i],
             Set::Unprocessed => false,
         });
         if !valid {
             return false;
         }
-        for &i in &clamped {
-            x[i] = x[i].clamp(self.lo[i], self.hi[i]);
+        for &i in &self.clamped {
+            self.x[i] = self.x[i].clamp(self.lo[i], self.hi[i]);
         }
-        self.x = x;
-        self.w = w;
         true
     }
 
