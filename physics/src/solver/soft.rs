@@ -120,9 +120,19 @@ struct PointConstraint {
     closing_acceleration: f64,
     /// Solved with its island's other points as one LCP (see `ContactLcp`).
     in_lcp: bool,
-    /// With the next point: the off-diagonal of their 2 × 2 normal mass matrix, when the
-    /// two are one manifold's and the block is well conditioned (solved together).
-    pair_coupling: Option<f64>,
+    /// With the next point: their 2 × 2 normal mass matrix, when the two are one
+    /// manifold's and the block is well conditioned (solved together).
+    pair_coupling: Option<NormalBlock>,
+}
+
+/// The 2 × 2 normal mass matrix K of a manifold's two points and its inverse, computed
+/// once per step so that the passes do not divide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NormalBlock {
+    k11: f64,
+    k12: f64,
+    k22: f64,
+    inverse: (f64, f64, f64),
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
@@ -147,12 +157,25 @@ struct SoftJoint {
     input: u32,
 }
 
+/// One manifold of the point-by-point passes: `points[start]`, with `points[start + 1]`
+/// too when the two are solved as a 2 × 2 block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Run {
+    colour: u8,
+    start: u32,
+    pair: bool,
+}
+
 /// Warm-start memory and buffers, kept between steps.
 #[derive(Debug, Clone, Default)]
 pub struct SoftStepSolver {
     bodies: Vec<SoftBody>,
     points: Vec<PointConstraint>,
     joints: Vec<SoftJoint>,
+    /// The manifolds solved point by point (a lone point or a 2 × 2 pair), in colour order.
+    runs: Vec<Run>,
+    /// Per body, the colours of the runs already touching it (see `colour_runs`).
+    body_colours: Vec<u64>,
     /// Last step's impulses by (body A, body B, feature), sorted for binary search.
     memory: Vec<((u32, u32, u32), f64, f64)>,
     next_memory: Vec<((u32, u32, u32), f64, f64)>,
@@ -300,9 +323,15 @@ impl SoftStepSolver {
             let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
             let det = k11 * k22 - k12 * k12;
             if p.normal_mass > 0.0 && q.normal_mass > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det {
-                self.points[i - 1].pair_coupling = Some(k12);
+                self.points[i - 1].pair_coupling = Some(NormalBlock {
+                    k11,
+                    k12,
+                    k22,
+                    inverse: (k22 / det, -k12 / det, k11 / det),
+                });
             }
         }
+        self.colour_runs();
         self.joints.clear();
         for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
@@ -333,6 +362,48 @@ impl SoftStepSolver {
             });
         }
         self.group_joints();
+    }
+
+    /// Lists the manifolds outside the small LCP islands and orders them by colour: runs of
+    /// one colour share no moving body. Gauss–Seidel then visits a sequence of independent
+    /// manifolds, whose updates the processor can overlap, instead of a chain in which
+    /// each manifold waits for the last one's write to a shared body (Box2D v3 colours its
+    /// constraint graph for the same reason, and to solve a colour in SIMD).
+    fn colour_runs(&mut self) {
+        self.runs.clear();
+        self.body_colours.clear();
+        self.body_colours.resize(self.bodies.len(), 0);
+        let moving = |b: &SoftBody| b.inv_mass > 0.0 || b.inv_inertia > 0.0;
+        let mut i = 0;
+        while i < self.points.len() {
+            let p = &self.points[i];
+            let pair = p.pair_coupling.is_some();
+            if !p.in_lcp {
+                let (a, b) = (p.a as usize, p.b as usize);
+                let mask = |k: usize| {
+                    if moving(&self.bodies[k]) {
+                        self.body_colours[k]
+                    } else {
+                        0
+                    }
+                };
+                // Past 64 colours, the rest share the last one (still solved correctly,
+                // only without the independence).
+                let colour = (!(mask(a) | mask(b))).trailing_zeros().min(63);
+                for k in [a, b] {
+                    if moving(&self.bodies[k]) {
+                        self.body_colours[k] |= 1 << colour;
+                    }
+                }
+                self.runs.push(Run {
+                    colour: colour as u8,
+                    start: i as u32,
+                    pair,
+                });
+            }
+            i += if pair { 2 } else { 1 };
+        }
+        self.runs.sort_unstable();
     }
 
     /// Records how each island of contacts and of pins was solved.
@@ -412,12 +483,9 @@ impl SoftStepSolver {
     }
 
     fn apply(bodies: &mut [SoftBody], a: u32, b: u32, r_a: Vec2, r_b: Vec2, impulse: Vec2) {
-        let ba = &mut bodies[a as usize];
-        ba.v += impulse * ba.inv_mass;
-        ba.w += ba.inv_inertia * cross(r_a, impulse);
-        let bb = &mut bodies[b as usize];
-        bb.v -= impulse * bb.inv_mass;
-        bb.w -= bb.inv_inertia * cross(r_b, impulse);
+        let mut pair = BodyPair::load(bodies, a, b);
+        pair.apply(r_a, r_b, impulse);
+        pair.store(bodies);
     }
 
     fn warm_start(&mut self) {
@@ -448,6 +516,7 @@ impl SoftStepSolver {
         use_bias: bool,
     ) {
         let (max_push, joint_push) = (settings.max_push_speed, settings.joint_push_speed);
+        let inv_h = 1.0 / h;
         for j in self.joints.iter_mut() {
             solve_motor(&mut self.bodies, j, h);
         }
@@ -467,36 +536,32 @@ impl SoftStepSolver {
         self.contact_lcp.solve(
             &mut self.bodies,
             &mut self.points,
-            h,
+            inv_h,
             contact_soft,
             max_push,
             use_bias,
         );
-        let mut i = 0;
-        while i < self.points.len() {
-            if self.points[i].in_lcp {
-                i += 1;
-            } else if self.points[i].pair_coupling.is_some() {
+        for run in &self.runs {
+            let i = run.start as usize;
+            if run.pair {
                 let (first, second) = self.points.split_at_mut(i + 1);
                 solve_pair(
                     &mut self.bodies,
                     (&mut first[i], &mut second[0]),
-                    h,
+                    inv_h,
                     contact_soft,
                     max_push,
                     use_bias,
                 );
-                i += 2;
             } else {
                 solve_point(
                     &mut self.bodies,
                     &mut self.points[i],
-                    h,
+                    inv_h,
                     contact_soft,
                     max_push,
                     use_bias,
                 );
-                i += 1;
             }
         }
     }
@@ -520,20 +585,21 @@ impl SoftStepSolver {
                 let (p, q) = (&mut first[i], &mut second[0]);
                 let target = |p: &PointConstraint| -p.restitution * p.relative_velocity;
                 let targets = (target(p), target(q));
-                let velocities = (
-                    normal_velocity(&self.bodies, p),
-                    normal_velocity(&self.bodies, q),
-                );
-                solve_normal_pair(&mut self.bodies, (p, q), velocities, targets, (1.0, 0.0));
+                let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
+                let velocities = (pair.normal_velocity(p), pair.normal_velocity(q));
+                solve_normal_pair(&mut pair, (p, q), velocities, targets, (1.0, 0.0));
+                pair.store(&mut self.bodies);
                 i += 2;
                 continue;
             }
             let stride = if paired { 2 } else { 1 };
             for p in &mut self.points[i..i + stride] {
                 if bounces(p) {
-                    let vn = normal_velocity(&self.bodies, p);
+                    let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
+                    let vn = pair.normal_velocity(p);
                     let impulse = -p.normal_mass * (vn + p.restitution * p.relative_velocity);
-                    apply_normal(&mut self.bodies, p, p.normal_impulse + impulse);
+                    apply_normal(&mut pair, p, p.normal_impulse + impulse);
+                    pair.store(&mut self.bodies);
                 }
             }
             i += stride;
@@ -584,9 +650,11 @@ impl SoftStepSolver {
 /// the step began.
 /// A speculative point closes its remaining gap within the substep without speeding up
 /// over it; the impact speed adds what the closing acceleration would have given there.
-fn approach(bodies: &[SoftBody], p: &mut PointConstraint, separation: f64) -> f64 {
-    let vn = normal_velocity(bodies, p);
-    if p.max_normal_impulse == 0.0 && vn < 0.0 {
+/// Only a point that may bounce needs it.
+#[inline(always)]
+fn approach(pair: &BodyPair, p: &mut PointConstraint, separation: f64) -> f64 {
+    let vn = pair.normal_velocity(p);
+    if p.restitution != 0.0 && p.max_normal_impulse == 0.0 && vn < 0.0 {
         let gained = 2.0 * p.closing_acceleration * separation.max(0.0);
         let impact = -(vn * vn + gained.max(0.0)).sqrt();
         p.relative_velocity = p.relative_velocity.min(impact);
@@ -594,27 +662,84 @@ fn approach(bodies: &[SoftBody], p: &mut PointConstraint, separation: f64) -> f6
     vn
 }
 
-fn normal_velocity(bodies: &[SoftBody], p: &PointConstraint) -> f64 {
-    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-    ((a.v + cross_scalar(a.w, p.r_a)) - (b.v + cross_scalar(b.w, p.r_b))).dot(&p.normal)
+/// The velocities and inverse masses of a constraint's two bodies: a manifold's solve
+/// reads them once and writes them back once, instead of at every row.
+#[derive(Debug, Clone, Copy)]
+struct BodyPair {
+    a: u32,
+    b: u32,
+    va: Vec2,
+    wa: f64,
+    vb: Vec2,
+    wb: f64,
+    inv_mass: (f64, f64),
+    inv_inertia: (f64, f64),
+}
+
+impl BodyPair {
+    #[inline(always)]
+    fn load(bodies: &[SoftBody], a: u32, b: u32) -> Self {
+        let (ba, bb) = (&bodies[a as usize], &bodies[b as usize]);
+        Self {
+            a,
+            b,
+            va: ba.v,
+            wa: ba.w,
+            vb: bb.v,
+            wb: bb.w,
+            inv_mass: (ba.inv_mass, bb.inv_mass),
+            inv_inertia: (ba.inv_inertia, bb.inv_inertia),
+        }
+    }
+
+    #[inline(always)]
+    fn store(&self, bodies: &mut [SoftBody]) {
+        let ba = &mut bodies[self.a as usize];
+        (ba.v, ba.w) = (self.va, self.wa);
+        let bb = &mut bodies[self.b as usize];
+        (bb.v, bb.w) = (self.vb, self.wb);
+    }
+
+    /// The velocity of anchor `r_a` on A relative to anchor `r_b` on B.
+    #[inline(always)]
+    fn relative_velocity(&self, r_a: Vec2, r_b: Vec2) -> Vec2 {
+        (self.va + cross_scalar(self.wa, r_a)) - (self.vb + cross_scalar(self.wb, r_b))
+    }
+
+    /// A point's normal velocity at its fixed anchors (A relative to B).
+    #[inline(always)]
+    fn normal_velocity(&self, p: &PointConstraint) -> f64 {
+        self.relative_velocity(p.r_a, p.r_b).dot(&p.normal)
+    }
+
+    /// `impulse` on A at `r_a`, its opposite on B at `r_b`.
+    #[inline(always)]
+    fn apply(&mut self, r_a: Vec2, r_b: Vec2, impulse: Vec2) {
+        self.va += impulse * self.inv_mass.0;
+        self.wa += self.inv_inertia.0 * cross(r_a, impulse);
+        self.vb -= impulse * self.inv_mass.1;
+        self.wb -= self.inv_inertia.1 * cross(r_b, impulse);
+    }
 }
 
 /// Sets a point's accumulated normal impulse to `total` (clamped at 0), applying the
 /// difference.
-fn apply_normal(bodies: &mut [SoftBody], p: &mut PointConstraint, total: f64) {
+#[inline(always)]
+fn apply_normal(pair: &mut BodyPair, p: &mut PointConstraint, total: f64) {
     let total = total.max(0.0);
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
     p.max_normal_impulse = p.max_normal_impulse.max(delta);
-    SoftStepSolver::apply(bodies, p.a, p.b, p.r_a, p.r_b, p.normal * delta);
+    pair.apply(p.r_a, p.r_b, p.normal * delta);
 }
 
 /// The velocity a point's normal row aims at (minus bias) and its softness: speculative
 /// (closing the gap and no more), soft with bias, or rigid in the relax pass.
+#[inline(always)]
 fn normal_target(
     bodies: &[SoftBody],
     p: &PointConstraint,
-    h: f64,
+    inv_h: f64,
     soft: &Softness,
     max_push: f64,
     use_bias: bool,
@@ -627,7 +752,7 @@ fn normal_target(
         (a.dp + rotate_delta(a.dq, p.r_a) - p.r_a) - (b.dp + rotate_delta(b.dq, p.r_b) - p.r_b);
     let separation = moved.dot(&p.normal) + p.base_separation;
     if separation > 0.0 {
-        (-separation / h, (1.0, 0.0), separation)
+        (-separation * inv_h, (1.0, 0.0), separation)
     } else if use_bias {
         (
             -(soft.bias_rate * separation).max(-max_push),
@@ -642,29 +767,30 @@ fn normal_target(
 fn solve_point(
     bodies: &mut [SoftBody],
     p: &mut PointConstraint,
-    h: f64,
+    inv_h: f64,
     soft: &Softness,
     max_push: f64,
     use_bias: bool,
 ) {
     let (target, (mass_scale, impulse_scale), separation) =
-        normal_target(bodies, p, h, soft, max_push, use_bias);
-    let vn = approach(bodies, p, separation);
+        normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+    let mut pair = BodyPair::load(bodies, p.a, p.b);
+    let vn = approach(&pair, p, separation);
     let impulse = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
-    apply_normal(bodies, p, p.normal_impulse + impulse);
-    solve_friction(bodies, p);
+    apply_normal(&mut pair, p, p.normal_impulse + impulse);
+    solve_friction(&mut pair, p);
+    pair.store(bodies);
 }
 
-fn solve_friction(bodies: &mut [SoftBody], p: &mut PointConstraint) {
-    let (a, b) = (bodies[p.a as usize], bodies[p.b as usize]);
+#[inline(always)]
+fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
     let t = perp(p.normal);
-    let dv = (a.v + cross_scalar(a.w, p.r_a)) - (b.v + cross_scalar(b.w, p.r_b));
-    let vt = dv.dot(&t);
+    let vt = pair.relative_velocity(p.r_a, p.r_b).dot(&t);
     let limit = p.friction * p.normal_impulse;
     let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
-    SoftStepSolver::apply(bodies, p.a, p.b, p.r_a, p.r_b, t * delta);
+    pair.apply(p.r_a, p.r_b, t * delta);
 }
 
 /// Two points of one manifold: normals together (when both rows have the same softness),
@@ -672,61 +798,65 @@ fn solve_friction(bodies: &mut [SoftBody], p: &mut PointConstraint) {
 fn solve_pair(
     bodies: &mut [SoftBody],
     (p, q): (&mut PointConstraint, &mut PointConstraint),
-    h: f64,
+    inv_h: f64,
     soft: &Softness,
     max_push: f64,
     use_bias: bool,
 ) {
-    let (tp, sp, dp) = normal_target(bodies, p, h, soft, max_push, use_bias);
-    let (tq, sq, dq) = normal_target(bodies, q, h, soft, max_push, use_bias);
+    let (tp, sp, dp) = normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+    let (tq, sq, dq) = normal_target(bodies, q, inv_h, soft, max_push, use_bias);
+    let mut pair = BodyPair::load(bodies, p.a, p.b);
     if sp == sq {
-        let (v1, v2) = (approach(bodies, p, dp), approach(bodies, q, dq));
-        solve_normal_pair(bodies, (p, q), (v1, v2), (tp, tq), sp);
+        let (v1, v2) = (approach(&pair, p, dp), approach(&pair, q, dq));
+        solve_normal_pair(&mut pair, (p, q), (v1, v2), (tp, tq), sp);
     } else {
         for (x, target, (mass_scale, impulse_scale), separation) in
             [(&mut *p, tp, sp, dp), (&mut *q, tq, sq, dq)]
         {
-            let vn = approach(bodies, x, separation);
+            let vn = approach(&pair, x, separation);
             let impulse =
                 -x.normal_mass * mass_scale * (vn - target) - impulse_scale * x.normal_impulse;
-            apply_normal(bodies, x, x.normal_impulse + impulse);
+            apply_normal(&mut pair, x, x.normal_impulse + impulse);
         }
     }
-    solve_friction(bodies, p);
-    solve_friction(bodies, q);
+    solve_friction(&mut pair, p);
+    solve_friction(&mut pair, q);
+    pair.store(bodies);
 }
 
 /// The 2 × 2 normal block as a small LCP, solved by trying its four active sets: find
 /// totals x ≥ 0 with w = (v_n − target) + K (x − (1 − s)·x₀) / m_s ≥ 0 and x·w = 0 (m_s, s
 /// the softness scales, x₀ the accumulated impulses; rigid rows have m_s = 1, s = 0).
+#[inline(always)]
 fn solve_normal_pair(
-    bodies: &mut [SoftBody],
+    pair: &mut BodyPair,
     (p, q): (&mut PointConstraint, &mut PointConstraint),
     (v1, v2): (f64, f64),
     (tp, tq): (f64, f64),
     (mass_scale, impulse_scale): (f64, f64),
 ) {
-    let k12 = p.pair_coupling.expect("paired points");
-    let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
+    let block = p.pair_coupling.expect("paired points");
     let (x1, x2) = (p.normal_impulse, q.normal_impulse);
     let keep = 1.0 - impulse_scale;
-    // A = K / m_s; b = v − target − A·keep·x₀.
-    let (a11, a12, a22) = (k11 / mass_scale, k12 / mass_scale, k22 / mass_scale);
-    let b1 = v1 - tp - keep * (a11 * x1 + a12 * x2);
-    let b2 = v2 - tq - keep * (a12 * x1 + a22 * x2);
-    let det = a11 * a22 - a12 * a12;
-    let both = ((a12 * b2 - a22 * b1) / det, (a12 * b1 - a11 * b2) / det);
+    // With A = K / m_s and b = v − target − A·keep·x₀, r = m_s·b; A x + b = 0 is then
+    // K x + r = 0, and the one-row cases are x₁ = −r₁ / k₁₁ (with normal_mass = 1 / k₁₁).
+    let (k11, k12, k22) = (block.k11, block.k12, block.k22);
+    let r1 = mass_scale * (v1 - tp) - keep * (k11 * x1 + k12 * x2);
+    let r2 = mass_scale * (v2 - tq) - keep * (k12 * x1 + k22 * x2);
+    let (i11, i12, i22) = block.inverse;
+    let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
+    let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
     let totals = if both.0 >= 0.0 && both.1 >= 0.0 {
         both
-    } else if -b1 / a11 >= 0.0 && a12 * (-b1 / a11) + b2 >= 0.0 {
-        (-b1 / a11, 0.0)
-    } else if -b2 / a22 >= 0.0 && a12 * (-b2 / a22) + b1 >= 0.0 {
-        (0.0, -b2 / a22)
+    } else if first >= 0.0 && k12 * first + r2 >= 0.0 {
+        (first, 0.0)
+    } else if second >= 0.0 && k12 * second + r1 >= 0.0 {
+        (0.0, second)
     } else {
-        (0.0, 0.0) // b ≥ 0 is the only case left for a positive definite A
+        (0.0, 0.0) // r ≥ 0 is the only case left for a positive definite K
     };
-    apply_normal(bodies, p, totals.0);
-    apply_normal(bodies, q, totals.1);
+    apply_normal(pair, p, totals.0);
+    apply_normal(pair, q, totals.1);
 }
 
 /// A joint motor: the relative spin driven towards its target, within ±max torque·h.
@@ -1043,7 +1173,7 @@ impl ContactLcp {
         &mut self,
         bodies: &mut [SoftBody],
         points: &mut [PointConstraint],
-        h: f64,
+        inv_h: f64,
         soft: &Softness,
         max_push: f64,
         use_bias: bool,
@@ -1058,11 +1188,11 @@ impl ContactLcp {
             self.hi.clear();
             self.friction_index.clear();
             for (i, p) in island.iter_mut().enumerate() {
-                let (target, _, separation) = normal_target(bodies, p, h, soft, max_push, use_bias);
-                let vn = approach(bodies, p, separation);
-                let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-                let vt = ((a.v + cross_scalar(a.w, p.r_a)) - (b.v + cross_scalar(b.w, p.r_b)))
-                    .dot(&perp(p.normal));
+                let (target, _, separation) =
+                    normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+                let pair = BodyPair::load(bodies, p.a, p.b);
+                let vn = approach(&pair, p, separation);
+                let vt = pair.relative_velocity(p.r_a, p.r_b).dot(&perp(p.normal));
                 self.b.extend([vn - target, vt]);
                 self.x.extend([p.normal_impulse, p.tangent_impulse]);
                 self.lo.extend([0.0, 0.0]);
@@ -1086,15 +1216,17 @@ impl ContactLcp {
             let stats = self.solver.solve(&problem, &mut self.x);
             if stats.method == LcpMethod::Rejected {
                 for p in island.iter_mut() {
-                    solve_point(bodies, p, h, soft, max_push, use_bias);
+                    solve_point(bodies, p, inv_h, soft, max_push, use_bias);
                 }
                 continue;
             }
             for (i, p) in island.iter_mut().enumerate() {
-                apply_normal(bodies, p, self.x[2 * i]);
+                let mut pair = BodyPair::load(bodies, p.a, p.b);
+                apply_normal(&mut pair, p, self.x[2 * i]);
                 let delta = self.x[2 * i + 1] - p.tangent_impulse;
                 p.tangent_impulse = self.x[2 * i + 1];
-                SoftStepSolver::apply(bodies, p.a, p.b, p.r_a, p.r_b, perp(p.normal) * delta);
+                pair.apply(p.r_a, p.r_b, perp(p.normal) * delta);
+                pair.store(bodies);
             }
         }
     }
