@@ -1,5 +1,6 @@
 //! A 20-row pyramid (210 unit boxes) under a chosen solver for profiling:
-//! `cargo run --release -p pe --example pyramid_profile -- soft 600`.
+//! `cargo run --release -p pe --example pyramid_profile -- soft 600 [rows] [fresh]`;
+//! `fresh` runs the separating-axis test on every pair every step (no manifold reuse).
 use pe::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
 use std::time::Instant;
 
@@ -12,8 +13,10 @@ fn main() {
     };
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
     let rows: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let fresh = args.next().as_deref() == Some("fresh");
     let mut w = World::new(Vec2::new(0.0, 10.0));
     w.settings.contact_solver = solver;
+    w.settings.reuse_manifolds = !fresh;
     w.friction = 0.6;
     let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
     w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
@@ -32,7 +35,8 @@ fn main() {
     }
     let per_step = started.elapsed().as_secs_f64() / steps as f64;
     println!(
-        "{solver:?}: {rows} rows, {:.1} µs/step (mean of {steps})",
-        per_step * 1e6
+        "{solver:?}: {rows} rows, {:.1} µs/step (mean of {steps}){}",
+        per_step * 1e6,
+        if fresh { ", no manifold reuse" } else { "" }
     );
 }

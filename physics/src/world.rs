@@ -1,9 +1,10 @@
 //! The world and its step: a list of named stages (SPEC §3.4).
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
+use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact};
 use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
-use crate::math::Vec2;
+use crate::math::{Rot, Vec2};
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
 use crate::solver::joint::{
@@ -44,6 +45,9 @@ pub struct StepSettings {
     pub continuous: bool,
     /// Substeps per step of the soft step (`ContactSolver::Soft`); Box2D v3's default, 4.
     pub soft_substeps: usize,
+    /// Whether a pair that has barely moved relative to itself keeps its last manifold's
+    /// features instead of a new separating-axis test (see `collide::reuse`).
+    pub reuse_manifolds: bool,
 }
 
 impl Default for StepSettings {
@@ -57,6 +61,7 @@ impl Default for StepSettings {
             sleeping: false,
             continuous: true,
             soft_substeps: 4,
+            reuse_manifolds: true,
         }
     }
 }
@@ -75,6 +80,12 @@ impl StepSettings {
     /// Penetration up to this depth is left alone, so resting contacts stay in touch.
     pub fn slop(&self) -> f64 {
         0.005 * self.length_scale
+    }
+
+    /// A pair keeps its manifold while no point of either body has moved relative to the
+    /// other by more than this since the manifold was found: a tenth of the slop.
+    pub fn manifold_reuse_tolerance(&self) -> f64 {
+        0.1 * self.slop()
     }
 
     /// A reference face is swapped for the other body's only when better by this much.
@@ -168,6 +179,7 @@ pub struct World {
     ignored_pairs: Vec<(u32, u32)>,
     body_motors: Vec<(BodyHandle, BodyMotor)>,
     manifolds: Vec<Manifold>,
+    manifold_cache: ManifoldCache,
     contacts: Vec<Contact>,
     /// Per body: the island it fell asleep with (woken together).
     sleep_labels: Vec<u32>,
@@ -185,6 +197,7 @@ struct Scratch {
     wake_broad_phase: SweepAndPrune,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
+    poses: Vec<Pose>,
     boxes: Vec<Option<Aabb>>,
     broad_phase: SweepAndPrune,
     pairs: Vec<(u32, u32)>,
@@ -1031,12 +1044,27 @@ impl World {
             .resize_with(self.bodies.len(), WorldPolygon::default);
         s.boxes.clear();
         s.reach.clear();
+        s.poses.clear();
         let margin = self.settings.contact_margin();
         for (body, polygon) in self.bodies.iter().zip(s.polygons.iter_mut()) {
             let reach = body.as_ref().map_or(0.0, |b| {
                 (b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius()) * dt
             });
             s.reach.push(reach);
+            s.poses.push(body.as_ref().map_or(
+                Pose {
+                    position: Vec2::zeros(),
+                    rotation: Rot::default(),
+                    angle: 0.0,
+                    radius: 0.0,
+                },
+                |b| Pose {
+                    position: b.position,
+                    rotation: b.rotation(),
+                    angle: b.angle,
+                    radius: b.bounding_radius(),
+                },
+            ));
             s.boxes.push(body.as_ref().map(|b| {
                 polygon.update(b);
                 polygon.aabb().grown(0.5 * margin + reach)
@@ -1054,14 +1082,36 @@ impl World {
         self.manifolds.clear();
         self.contacts.clear();
         let tie = self.settings.tie_tolerance();
+        let reuse_tolerance = self.settings.manifold_reuse_tolerance();
+        let cache = &mut self.manifold_cache;
+        if self.settings.reuse_manifolds {
+            cache.begin_step();
+        } else {
+            cache.clear();
+        }
         for &(i, j) in &s.pairs {
             let (a, b) = (BodyHandle(i), BodyHandle(j));
-            let found = collide_polygons(
-                (a, &s.polygons[i as usize]),
-                (b, &s.polygons[j as usize]),
-                margin + s.reach[i as usize] + s.reach[j as usize],
-                tie,
-            );
+            let (pose_a, pose_b) = (&s.poses[i as usize], &s.poses[j as usize]);
+            let pair_margin = margin + s.reach[i as usize] + s.reach[j as usize];
+            let reused = if self.settings.reuse_manifolds {
+                cache.reuse((a, pose_a), (b, pose_b), pair_margin, reuse_tolerance)
+            } else {
+                None
+            };
+            let found = reused.or_else(|| {
+                let found = collide_polygons(
+                    (a, &s.polygons[i as usize]),
+                    (b, &s.polygons[j as usize]),
+                    pair_margin,
+                    tie,
+                );
+                if let Some(m) = &found
+                    && self.settings.reuse_manifolds
+                {
+                    cache.store(m, (pose_a, pose_b), pair_margin);
+                }
+                found
+            });
             if let Some(m) = found {
                 self.manifolds.push(m);
             }

@@ -1,6 +1,7 @@
 //! Collision detection: bounds, the broad phase and the SAT narrow phase (SPEC §3.1).
 
 mod broad;
+pub mod reuse;
 mod sat;
 pub mod toi;
 

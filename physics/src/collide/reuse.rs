@@ -1,0 +1,294 @@
+//! Manifold reuse: a pair whose relative pose has barely changed since its manifold was
+//! found keeps that manifold's features, with depths and positions recomputed at the
+//! current poses, instead of running the separating-axis test again.
+//!
+//! A manifold point is an incident vertex (or a clipped point on an incident edge) against
+//! the reference edge's line. Both are stored in their own body's frame, so a reused point
+//! is the same material point SAT would clip, and its depth is SAT's formula at the current
+//! poses. What reuse can miss is a change of features: a clipped point sliding along its
+//! edge, or another edge becoming the reference. Both need the relative pose to move by
+//! more than the tolerance, which is kept far below the contact slop.
+
+use super::{ContactPoint, FeatureId, Manifold};
+use crate::body::BodyHandle;
+use crate::math::{Rot, Vec2};
+
+/// Where a body is for the narrow phase: centroid, rotation, and the radius of the circle
+/// about the centroid that holds it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    pub position: Vec2,
+    pub rotation: Rot,
+    pub angle: f64,
+    pub radius: f64,
+}
+
+impl Pose {
+    fn to_world(self, local: Vec2) -> Vec2 {
+        self.position + self.rotation.apply(local)
+    }
+
+    fn to_local(self, world: Vec2) -> Vec2 {
+        self.rotation.apply_inverse(world - self.position)
+    }
+}
+
+/// B's centroid in A's frame and B's angle less A's.
+fn relative_pose(a: &Pose, b: &Pose) -> (Vec2, f64) {
+    (a.to_local(b.position), b.angle - a.angle)
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CachedPoint {
+    /// On the incident body, in its frame.
+    incident: Vec2,
+    /// On the reference edge's line, in the reference body's frame.
+    reference: Vec2,
+    id: FeatureId,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CachedManifold {
+    pair: (u32, u32),
+    relative: (Vec2, f64),
+    margin: f64,
+    reference_is_b: bool,
+    /// The reference edge's outward normal in the reference body's frame.
+    normal: Vec2,
+    points: [CachedPoint; 2],
+    len: u8,
+}
+
+/// Last step's manifolds, sorted by pair, and this step's as they are found.
+#[derive(Debug, Clone, Default)]
+pub struct ManifoldCache {
+    last: Vec<CachedManifold>,
+    next: Vec<CachedManifold>,
+    cursor: usize,
+}
+
+impl ManifoldCache {
+    /// Starts a step: the manifolds kept in the last one become the ones to reuse. Pairs
+    /// must then be visited in increasing order.
+    pub fn begin_step(&mut self) {
+        std::mem::swap(&mut self.last, &mut self.next);
+        self.next.clear();
+        self.cursor = 0;
+    }
+
+    /// Forgets every manifold.
+    pub fn clear(&mut self) {
+        self.last.clear();
+        self.next.clear();
+        self.cursor = 0;
+    }
+
+    /// The pair's last manifold at the current poses, if the pair has moved relative to
+    /// itself by less than `tolerance` (at any point of either body) since it was found,
+    /// `margin` is no wider than it was then, and a point is still within `margin`.
+    /// `None` asks for a fresh test, whose result goes to `store`.
+    pub fn reuse(
+        &mut self,
+        (a, pose_a): (BodyHandle, &Pose),
+        (b, pose_b): (BodyHandle, &Pose),
+        margin: f64,
+        tolerance: f64,
+    ) -> Option<Manifold> {
+        let pair = (a.0, b.0);
+        while self.last.get(self.cursor).is_some_and(|c| c.pair < pair) {
+            self.cursor += 1;
+        }
+        let cached = *self.last.get(self.cursor).filter(|c| c.pair == pair)?;
+        let (offset, turn) = relative_pose(pose_a, pose_b);
+        let moved = (offset - cached.relative.0).norm()
+            + (turn - cached.relative.1).abs() * pose_a.radius.max(pose_b.radius);
+        if moved > tolerance || margin > cached.margin {
+            return None;
+        }
+        let (reference, incident) = if cached.reference_is_b {
+            (pose_b, pose_a)
+        } else {
+            (pose_a, pose_b)
+        };
+        let u = reference.rotation.apply(cached.normal);
+        let mut manifold = Manifold::new(a, b, if cached.reference_is_b { u } else { -u });
+        for p in &cached.points[..cached.len as usize] {
+            let point = incident.to_world(p.incident);
+            let separation = u.dot(&(point - reference.to_world(p.reference)));
+            if separation <= margin {
+                manifold.push(ContactPoint {
+                    position: point - u * (0.5 * separation),
+                    depth: -separation,
+                    id: p.id,
+                });
+            }
+        }
+        if manifold.points().is_empty() {
+            return None;
+        }
+        self.next.push(cached);
+        Some(manifold)
+    }
+
+    /// Keeps a freshly found manifold for the next steps.
+    pub fn store(&mut self, manifold: &Manifold, (pose_a, pose_b): (&Pose, &Pose), margin: f64) {
+        let Some(first) = manifold.points().first() else {
+            return;
+        };
+        // collide_polygons marks a manifold whose reference edge is B's in bit 31 of every
+        // point's feature id; the normal is the reference normal, or its opposite when the
+        // reference is A's.
+        let reference_is_b = first.id.0 & (1 << 31) != 0;
+        let (reference, incident, u) = if reference_is_b {
+            (pose_b, pose_a, manifold.normal)
+        } else {
+            (pose_a, pose_b, -manifold.normal)
+        };
+        let mut points = [CachedPoint {
+            incident: Vec2::zeros(),
+            reference: Vec2::zeros(),
+            id: FeatureId(0),
+        }; 2];
+        for (slot, p) in points.iter_mut().zip(manifold.points()) {
+            // position = incident point − u·separation/2, with separation = −depth.
+            let point = p.position - u * (0.5 * p.depth);
+            *slot = CachedPoint {
+                incident: incident.to_local(point),
+                reference: reference.to_local(point + u * p.depth),
+                id: p.id,
+            };
+        }
+        self.next.push(CachedManifold {
+            pair: (manifold.body_a.0, manifold.body_b.0),
+            relative: relative_pose(pose_a, pose_b),
+            margin,
+            reference_is_b,
+            normal: reference.rotation.apply_inverse(u),
+            points,
+            len: manifold.points().len() as u8,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::{WorldPolygon, collide_polygons};
+
+    fn unit_square() -> Vec<Vec2> {
+        vec![
+            Vec2::new(-0.5, -0.5),
+            Vec2::new(0.5, -0.5),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(-0.5, 0.5),
+        ]
+    }
+
+    fn placed(local: &[Vec2], position: Vec2, angle: f64) -> (WorldPolygon, Pose) {
+        let pose = Pose {
+            position,
+            rotation: Rot::new(angle),
+            angle,
+            radius: local.iter().map(|v| v.norm()).fold(0.0, f64::max),
+        };
+        let mut polygon = WorldPolygon::default();
+        polygon.set_vertices(local.iter().map(|&v| pose.to_world(v)));
+        (polygon, pose)
+    }
+
+    /// A box resting on a wider slab, one of them turned a little, then nudged by up to
+    /// the tolerance in every direction and turn: the reused manifold has SAT's features
+    /// and normal, and depths and positions within what that motion can change (a clipped
+    /// point slides with the other body; depths move by slide × tilt).
+    #[test]
+    fn reused_manifold_matches_a_fresh_test_after_small_motion() {
+        let slab: Vec<Vec2> = [(-3.0, -0.5), (3.0, -0.5), (3.0, 0.5), (-3.0, 0.5)]
+            .iter()
+            .map(|&(x, y)| Vec2::new(x, y))
+            .collect();
+        let (margin, tie, tolerance) = (0.02, 0.001, 5e-4);
+        let (handle_a, handle_b) = (BodyHandle(0), BodyHandle(1));
+        let mut references_seen = [false; 2];
+        for slab_first in [false, true] {
+            for (box_tilt, slab_tilt) in [(0.0, 0.0), (0.002, 0.0), (0.0, 0.002)] {
+                let box_at = Vec2::new(0.3, 0.999);
+                let (a, b) = if slab_first {
+                    (
+                        (slab.clone(), Vec2::zeros(), slab_tilt),
+                        (unit_square(), box_at, box_tilt),
+                    )
+                } else {
+                    (
+                        (unit_square(), -box_at, box_tilt),
+                        (slab.clone(), Vec2::zeros(), slab_tilt),
+                    )
+                };
+                let (poly_a, pose_a) = placed(&a.0, a.1, a.2);
+                let (poly_b, pose_b) = placed(&b.0, b.1, b.2);
+                let first = collide_polygons((handle_a, &poly_a), (handle_b, &poly_b), margin, tie)
+                    .expect("in contact");
+                references_seen[(first.points()[0].id.0 >> 31) as usize] = true;
+                let mut cache = ManifoldCache::default();
+                cache.store(&first, (&pose_a, &pose_b), margin);
+                for k in 0..16 {
+                    let heading = k as f64 * std::f64::consts::TAU / 16.0;
+                    let shift = Vec2::new(heading.cos(), heading.sin()) * (0.4 * tolerance);
+                    let turn = 0.4 * tolerance / pose_a.radius.max(pose_b.radius) * heading.sin();
+                    // The box moves; the slab stays.
+                    let ((poly_a2, pose_a2), (poly_b2, pose_b2)) = if slab_first {
+                        (
+                            (poly_a.clone(), pose_a),
+                            placed(&b.0, b.1 + shift, b.2 + turn),
+                        )
+                    } else {
+                        (
+                            placed(&a.0, a.1 + shift, a.2 + turn),
+                            (poly_b.clone(), pose_b),
+                        )
+                    };
+                    cache.begin_step();
+                    let reused = cache
+                        .reuse(
+                            (handle_a, &pose_a2),
+                            (handle_b, &pose_b2),
+                            margin,
+                            tolerance,
+                        )
+                        .expect("within the tolerance");
+                    let fresh =
+                        collide_polygons((handle_a, &poly_a2), (handle_b, &poly_b2), margin, tie)
+                            .expect("in contact");
+                    assert!((reused.normal - fresh.normal).norm() < 1e-12);
+                    assert_eq!(reused.points().len(), fresh.points().len());
+                    for (r, f) in reused.points().iter().zip(fresh.points()) {
+                        assert_eq!(r.id, f.id);
+                        assert!((r.depth - f.depth).abs() < 1e-6, "{} {}", r.depth, f.depth);
+                        assert!((r.position - f.position).norm() <= tolerance);
+                    }
+                }
+                // Measured against the manifold's first pose, not the last step's: beyond
+                // the tolerance from there, a fresh test is asked for.
+                let far = |pose: &Pose| Pose {
+                    position: pose.position + Vec2::new(1.1 * tolerance, 0.0),
+                    ..*pose
+                };
+                cache.begin_step();
+                let (pa, pb) = if slab_first {
+                    (pose_a, far(&pose_b))
+                } else {
+                    (far(&pose_a), pose_b)
+                };
+                assert!(
+                    cache
+                        .reuse((handle_a, &pa), (handle_b, &pb), margin, tolerance)
+                        .is_none()
+                );
+            }
+        }
+        assert_eq!(
+            references_seen,
+            [true, true],
+            "both bodies served as reference"
+        );
+    }
+}
