@@ -159,7 +159,7 @@ struct SoftJoint {
 
 /// One manifold of the point-by-point passes: `points[start]`, with `points[start + 1]`
 /// too when the two are solved as a 2 × 2 block.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 struct Run {
     colour: u8,
     start: u32,
@@ -174,9 +174,11 @@ pub struct SoftStepSolver {
     joints: Vec<SoftJoint>,
     /// The manifolds solved point by point (a lone point or a 2 × 2 pair), in colour order.
     runs: Vec<Run>,
+    sorted_runs: Vec<Run>,
     /// Per body, the colours of the runs already touching it (see `colour_runs`).
     body_colours: Vec<u64>,
-    /// Last step's impulses by (body A, body B, feature), sorted for binary search.
+    /// Last step's impulses by (body A, body B, feature), in the order of its contacts:
+    /// by body pair, as the broad phase lists pairs.
     memory: Vec<((u32, u32, u32), f64, f64)>,
     next_memory: Vec<((u32, u32, u32), f64, f64)>,
     joint_memory: Vec<(u32, Vec2, f64)>,
@@ -268,6 +270,9 @@ impl SoftStepSolver {
             dangle: 0.0,
         }));
         self.points.clear();
+        // Contacts come by body pair in increasing order, as last step's did: one walk
+        // through the memory finds each pair's entries.
+        let mut cursor = 0;
         for (i, c) in contacts.iter().enumerate() {
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
             let r_a = c.point - a.position;
@@ -278,12 +283,16 @@ impl SoftStepSolver {
                 a.inv_mass + b.inv_mass + a.inv_inertia * ca * ca + b.inv_inertia * cb * cb
             };
             let inverse = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
-            let key = (c.body_a, c.body_b, c.id.0);
-            let (normal_impulse, tangent_impulse) =
-                match self.memory.binary_search_by(|m| m.0.cmp(&key)) {
-                    Ok(k) => (self.memory[k].1, self.memory[k].2),
-                    Err(_) => (0.0, 0.0),
-                };
+            let pair = (c.body_a, c.body_b);
+            let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
+            while self.memory.get(cursor).is_some_and(|m| pair_of(m) < pair) {
+                cursor += 1;
+            }
+            let (normal_impulse, tangent_impulse) = self.memory[cursor..]
+                .iter()
+                .take_while(|m| pair_of(m) == pair)
+                .find(|m| m.0.2 == c.id.0)
+                .map_or((0.0, 0.0), |m| (m.1, m.2));
             self.points.push(PointConstraint {
                 contact: i as u32,
                 a: c.body_a,
@@ -403,7 +412,22 @@ impl SoftStepSolver {
             }
             i += if pair { 2 } else { 1 };
         }
-        self.runs.sort_unstable();
+        // By colour, each colour keeping the points' order (a counting sort: few colours).
+        let mut starts = [0u32; 65];
+        for run in &self.runs {
+            starts[run.colour as usize + 1] += 1;
+        }
+        for c in 1..starts.len() {
+            starts[c] += starts[c - 1];
+        }
+        self.sorted_runs.clear();
+        self.sorted_runs.resize(self.runs.len(), Run::default());
+        for run in &self.runs {
+            let slot = &mut starts[run.colour as usize];
+            self.sorted_runs[*slot as usize] = *run;
+            *slot += 1;
+        }
+        std::mem::swap(&mut self.runs, &mut self.sorted_runs);
     }
 
     /// Records how each island of contacts and of pins was solved.
@@ -622,14 +646,15 @@ impl SoftStepSolver {
             b.angle += s.dangle;
         }
         self.next_memory.clear();
+        self.next_memory
+            .resize(contacts.len(), ((u32::MAX, u32::MAX, 0), 0.0, 0.0));
         for p in &self.points {
             let c = &mut contacts[p.contact as usize];
             c.normal_impulse = p.normal_impulse;
             c.tangent_impulse = p.tangent_impulse;
-            self.next_memory
-                .push(((p.a, p.b, c.id.0), p.normal_impulse, p.tangent_impulse));
+            self.next_memory[p.contact as usize] =
+                ((p.a, p.b, c.id.0), p.normal_impulse, p.tangent_impulse);
         }
-        self.next_memory.sort_unstable_by_key(|x| x.0);
         std::mem::swap(&mut self.memory, &mut self.next_memory);
         self.joint_memory.clear();
         for j in &self.joints {
