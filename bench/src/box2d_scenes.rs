@@ -65,13 +65,24 @@ fn centre(world: &World, body: BodyId) -> (f64, f64) {
 }
 
 /// The static floor, top face at y = 0, restitution 0 (the pair takes the larger).
-fn floor(w: &mut World) {
-    boxed(w, BodyType::Static, (0.0, -0.5 * FLOOR.1), FLOOR, 0.0, 0.0);
+/// The static floor, its top face at height `top`.
+fn floor(w: &mut World, top: f64) {
+    boxed(
+        w,
+        BodyType::Static,
+        (0.0, top - 0.5 * FLOOR.1),
+        FLOOR,
+        0.0,
+        0.0,
+    );
 }
 
-pub fn pyramid(spec: &Pyramid) -> Outcome {
+/// A pyramid (or stack) stepped at `h` for `spec.steps`.
+pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
     let mut w = world();
-    floor(&mut w);
+    for top in spec.floor_tops() {
+        floor(&mut w, top);
+    }
     let centres = spec.centres();
     let boxes: Vec<BodyId> = centres
         .iter()
@@ -81,7 +92,7 @@ pub fn pyramid(spec: &Pyramid) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps,
-        |w| step(w, H, SUBSTEPS),
+        |w| step(w, h, substeps),
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
@@ -202,7 +213,7 @@ pub fn heavy_chain(h: f64, substeps: i32) -> Outcome {
 
 pub fn bounce(h: f64, substeps: i32) -> Outcome {
     let mut w = world();
-    floor(&mut w);
+    floor(&mut w, 0.0);
     let half = 0.5 * bounce::SIZE;
     let body = boxed(
         &mut w,

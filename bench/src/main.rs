@@ -114,9 +114,9 @@ fn main() {
         rows.push(run_row(
             spec.name,
             "stands: drift 0, 0 fallen".into(),
-            |s| pe_scenes::pyramid(PeConfig::new(s), spec),
-            || rapier_scenes::pyramid(spec),
-            || box2d_scenes::pyramid(spec),
+            |s| pe_scenes::pyramid(PeConfig::new(s), spec, H),
+            || rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS),
+            || box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS),
         ));
     }
     for spec in &PENDULUMS {
@@ -156,7 +156,8 @@ fn main() {
         rapier_scenes::smash,
         box2d_scenes::smash,
     ));
-    let report = report(&rows, started.elapsed(), &load);
+    let narrow = narrow_phase_rows(&rows);
+    let report = report(&rows, &narrow, started.elapsed(), &load);
     println!("{report}");
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench/results.md");
     if let Err(e) = std::fs::write(path, &report) {
@@ -164,6 +165,45 @@ fn main() {
         std::process::exit(1);
     }
     eprintln!("written to docs/bench/results.md");
+}
+
+/// pe soft with the narrow phase's manifold reuse on (the row's own run) and off, on the
+/// scenes of many resting contacts.
+struct NarrowRow {
+    scene: String,
+    reuse: Outcome,
+    fresh: Outcome,
+}
+
+fn narrow_phase_rows(rows: &[Row]) -> Vec<NarrowRow> {
+    let soft = PE_SOLVERS
+        .iter()
+        .position(|&s| s == ContactSolver::Soft)
+        .expect("soft is compared");
+    let fresh = PeConfig {
+        reuse_manifolds: false,
+        ..PeConfig::new(ContactSolver::Soft)
+    };
+    let own_row = |name: &str| {
+        let row = rows.iter().find(|r| r.scene == name).expect("scene ran");
+        row.pe[soft]
+    };
+    let mut out = Vec::new();
+    for spec in &PYRAMIDS {
+        eprintln!("{}: pe soft without manifold reuse…", spec.name);
+        out.push(NarrowRow {
+            scene: spec.name.to_string(),
+            reuse: own_row(spec.name),
+            fresh: pe_scenes::pyramid(fresh, spec, H),
+        });
+    }
+    eprintln!("{}: pe soft without manifold reuse…", smash::NAME);
+    out.push(NarrowRow {
+        scene: smash::NAME.to_string(),
+        reuse: own_row(smash::NAME),
+        fresh: pe_scenes::smash(fresh),
+    });
+    out
 }
 
 /// A duration with three significant figures in a readable unit.
@@ -211,7 +251,7 @@ fn ratio(pe: Duration, peer: Duration) -> String {
     }
 }
 
-fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
+fn report(rows: &[Row], narrow: &[NarrowRow], elapsed: Duration, load: &str) -> String {
     let names: Vec<&str> = PE_SOLVERS.iter().map(|s| s.name()).collect();
     let mut md = String::new();
     let w = &mut md;
@@ -250,7 +290,8 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
         w,
         "- Step h = 1/60 s except where the scene says; g = 10 m/s². pyramid40 is planned \
          for 300 steps (5 s) instead of 600 to bound the run time; large_pyramid (base 100, \
-         5,050 boxes) for 500 steps as in Box2D's benchmark; smash (an 8 m box of density 10 \
+         5,050 boxes) for 500 steps as in Box2D's benchmark; many_pyramids (10 × 10 pyramids \
+         of base 10, 5,500 boxes, ten to a floor on ten floors) for 300; smash (an 8 m box of density 10 \
          at 40 m/s into 120 × 80 boxes of 0.5 m, no gravity) and joint_grid (100 × 100 bodies, \
          19,800 pins) for 300; the pendulums run 60 s."
     );
@@ -308,6 +349,36 @@ fn report(rows: &[Row], elapsed: Duration, load: &str) -> String {
          — the largest drift of the total linear momentum from its start (no gravity, no \
          static body: it is conserved exactly), and the kinetic energy left at the end."
     );
+
+    let _ = writeln!(w, "\n## Narrow phase: manifold reuse (pe soft)\n");
+    let _ = writeln!(
+        w,
+        "A pair whose relative pose has moved less than a tenth of the slop since its \
+         manifold was found keeps that manifold's features (recomputed at the current \
+         poses) instead of a new separating-axis test; `fresh` tests every pair every step.\n"
+    );
+    let columns: Vec<String> = [
+        "reuse: time per step",
+        "fresh: time per step",
+        "fresh ÷ reuse",
+        "reuse: result",
+        "fresh: result",
+    ]
+    .map(String::from)
+    .to_vec();
+    let _ = writeln!(w, "{}", table_head(&["scene"], &columns, "---:"));
+    for r in narrow {
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} | {} | {} |",
+            r.scene,
+            time_cell(&r.reuse.timing),
+            time_cell(&r.fresh.timing),
+            ratio(r.fresh.timing.median, r.reuse.timing.median),
+            metric_cell(&r.reuse),
+            metric_cell(&r.fresh)
+        );
+    }
     md
 }
 

@@ -12,13 +12,14 @@ use pe::{
     World,
 };
 
-/// How pe is set up for a run: the contact solver, the integrator, and the soft step's
-/// substeps (used by `soft` only).
+/// How pe is set up for a run: the contact solver, the integrator, the soft step's
+/// substeps (used by `soft` only), and whether the narrow phase reuses manifolds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PeConfig {
     pub solver: ContactSolver,
     pub integrator: Integrator,
     pub soft_substeps: usize,
+    pub reuse_manifolds: bool,
 }
 
 impl PeConfig {
@@ -28,6 +29,7 @@ impl PeConfig {
             solver,
             integrator: Integrator::default(),
             soft_substeps: 4,
+            reuse_manifolds: true,
         }
     }
 }
@@ -48,6 +50,7 @@ fn world(config: PeConfig) -> World {
     w.settings.contact_solver = config.solver;
     w.settings.integrator = config.integrator;
     w.settings.soft_substeps = config.soft_substeps;
+    w.settings.reuse_manifolds = config.reuse_manifolds;
     // All bodies are metre-sized: pe's tolerances (contact margin, slop, joint tolerance)
     // scale with this.
     w.settings.length_scale = 1.0;
@@ -61,16 +64,20 @@ fn rectangle(w: f64, h: f64) -> ConvexPolygon {
 
 /// The static floor, top face at y = 0. Restitution 1 because pe combines a pair's
 /// restitutions by their minimum: the moving body's own value then applies.
-fn floor(w: &mut World) {
+/// The static floor, its top face at height `top`.
+fn floor(w: &mut World, top: f64) {
     let def = BodyDef::new(rectangle(FLOOR.0, FLOOR.1), 0.0)
         .restitution(1.0)
-        .at(at((0.0, -0.5 * FLOOR.1)), 0.0);
+        .at(at((0.0, top - 0.5 * FLOOR.1)), 0.0);
     w.add_body(def).expect("valid floor");
 }
 
-pub fn pyramid(config: PeConfig, spec: &Pyramid) -> Outcome {
+/// A pyramid (or stack) stepped at `h` for `spec.steps`.
+pub fn pyramid(config: PeConfig, spec: &Pyramid, h: f64) -> Outcome {
     let mut w = world(config);
-    floor(&mut w);
+    for top in spec.floor_tops() {
+        floor(&mut w, top);
+    }
     let unit = rectangle(BOX, BOX);
     let centres = spec.centres();
     let boxes: Vec<BodyHandle> = centres
@@ -84,7 +91,7 @@ pub fn pyramid(config: PeConfig, spec: &Pyramid) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps,
-        |w| w.step(H),
+        |w| w.step(h),
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
@@ -147,7 +154,7 @@ pub fn heavy_chain(config: PeConfig, h: f64) -> Outcome {
 
 pub fn bounce(config: PeConfig, h: f64) -> Outcome {
     let mut w = world(config);
-    floor(&mut w);
+    floor(&mut w, 0.0);
     let half = 0.5 * bounce::SIZE;
     let def = BodyDef::new(rectangle(bounce::SIZE, bounce::SIZE), 1.0)
         .restitution(bounce::RESTITUTION)

@@ -48,9 +48,10 @@ fn cuboid(w: f64, h: f64, density: f64) -> ColliderBuilder {
 
 /// The static floor, top face at y = 0, with the scenes' friction so that rapier's default
 /// averaging of the pair's coefficients gives exactly `FRICTION`.
-fn floor(w: &mut PhysicsWorld, restitution: f64) {
+/// The static floor, its top face at height `top`.
+fn floor(w: &mut PhysicsWorld, top: f64, restitution: f64) {
     let body = RigidBodyBuilder::fixed()
-        .translation(point((0.0, -0.5 * FLOOR.1)))
+        .translation(point((0.0, top - 0.5 * FLOOR.1)))
         .can_sleep(false);
     let shape = cuboid(FLOOR.0, FLOOR.1, 0.0)
         .friction(FRICTION as Real)
@@ -58,9 +59,12 @@ fn floor(w: &mut PhysicsWorld, restitution: f64) {
     w.insert(body, shape);
 }
 
-pub fn pyramid(spec: &Pyramid) -> Outcome {
-    let mut w = world(H, ITERATIONS);
-    floor(&mut w, 0.0);
+/// A pyramid (or stack) stepped at `h` for `spec.steps`.
+pub fn pyramid(spec: &Pyramid, h: f64, iterations: usize) -> Outcome {
+    let mut w = world(h, iterations);
+    for top in spec.floor_tops() {
+        floor(&mut w, top, 0.0);
+    }
     let centres = spec.centres();
     let boxes: Vec<RigidBodyHandle> = centres
         .iter()
@@ -161,7 +165,7 @@ pub fn heavy_chain(h: f64, iterations: usize) -> Outcome {
 pub fn bounce(h: f64, iterations: usize) -> Outcome {
     let mut w = world(h, iterations);
     // Rapier averages the pair's restitutions by default: with 0.5 on both the pair's is 0.5.
-    floor(&mut w, bounce::RESTITUTION);
+    floor(&mut w, 0.0, bounce::RESTITUTION);
     let half = 0.5 * bounce::SIZE;
     let shape = cuboid(bounce::SIZE, bounce::SIZE, 1.0)
         .friction(FRICTION as Real)

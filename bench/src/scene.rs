@@ -29,47 +29,99 @@ pub fn worst(so_far: f64, sample: f64) -> f64 {
     }
 }
 
-/// A pyramid of unit boxes, `rows` at the base, standing on the floor.
+/// A pyramid of unit boxes, `rows` at the base, standing on the floor; or a grid of them,
+/// `grid.0` side by side on each of `grid.1` floors stacked one above the other. With
+/// `stack`, a column of `rows` boxes instead.
 #[derive(Debug, Clone, Copy)]
 pub struct Pyramid {
     pub name: &'static str,
     pub rows: usize,
     pub steps: usize,
+    pub grid: (usize, usize),
+    pub stack: bool,
 }
 
-pub const PYRAMIDS: [Pyramid; 3] = [
+pub const PYRAMIDS: [Pyramid; 4] = [
     Pyramid {
         name: "pyramid20",
         rows: 20,
         steps: 600,
+        grid: (1, 1),
+        stack: false,
     },
     // 820 boxes: 300 steps (5 s) keep the whole benchmark within a few minutes.
     Pyramid {
         name: "pyramid40",
         rows: 40,
         steps: 300,
+        grid: (1, 1),
+        stack: false,
     },
     // Box2D's large_pyramid benchmark: base 100, 5,050 boxes, 500 steps.
     Pyramid {
         name: "large_pyramid",
         rows: 100,
         steps: 500,
+        grid: (1, 1),
+        stack: false,
+    },
+    // After Box2D's many_pyramids: many small islands instead of one big one. 10 × 10
+    // pyramids of base 10 (5,500 boxes, as many as large_pyramid), ten to a floor.
+    Pyramid {
+        name: "many_pyramids",
+        rows: 10,
+        steps: 300,
+        grid: (10, 10),
+        stack: false,
+    },
+];
+
+/// Stacks of 10 and 20 boxes for 10 s at `H` (the sweep sets its own step).
+pub const STACKS: [Pyramid; 2] = [
+    Pyramid {
+        name: "stack10",
+        rows: 10,
+        steps: 600,
+        grid: (1, 1),
+        stack: true,
+    },
+    Pyramid {
+        name: "stack20",
+        rows: 20,
+        steps: 600,
+        grid: (1, 1),
+        stack: true,
     },
 ];
 
 impl Pyramid {
     /// Box centres, bottom row first and the top box last. The boxes touch their
     /// neighbours and the floor exactly, so nothing falls or overlaps at the start.
+    /// In a grid, pyramid by pyramid, floor by floor: the top box is the last pyramid's.
     pub fn centres(&self) -> Vec<(f64, f64)> {
-        let mut centres = Vec::with_capacity(self.rows * (self.rows + 1) / 2);
-        for row in 0..self.rows {
-            let count = self.rows - row;
-            let left = -0.5 * (count - 1) as f64 * BOX;
-            for k in 0..count {
-                centres.push((left + k as f64 * BOX, (row as f64 + 0.5) * BOX));
+        let (columns, floors) = self.grid;
+        let mut centres = Vec::with_capacity(columns * floors * self.rows * (self.rows + 1) / 2);
+        for &base in &self.floor_tops() {
+            for column in 0..columns {
+                // One box of space between neighbouring pyramids.
+                let middle = (column as f64 - 0.5 * (columns - 1) as f64) * (self.rows + 1) as f64;
+                for row in 0..self.rows {
+                    let count = if self.stack { 1 } else { self.rows - row };
+                    let left = middle - 0.5 * (count - 1) as f64 * BOX;
+                    for k in 0..count {
+                        centres.push((left + k as f64 * BOX, base + (row as f64 + 0.5) * BOX));
+                    }
+                }
             }
         }
         centres
+    }
+
+    /// The height of each floor's top face: the first at 0, the next a box above the
+    /// pyramids below it (plus the floor's own thickness).
+    pub fn floor_tops(&self) -> Vec<f64> {
+        let spacing = (self.rows + 1) as f64 * BOX + FLOOR.1;
+        (0..self.grid.1).map(|k| k as f64 * spacing).collect()
     }
 }
 
@@ -529,6 +581,38 @@ mod tests {
         assert_eq!(c.len(), 210);
         assert_eq!(*c.last().unwrap(), (0.0, 19.5));
         assert_eq!(c[0], (-9.5, 0.5));
+    }
+
+    /// 100 pyramids of 55 boxes; no box overlaps another or a floor (all are unit boxes,
+    /// so centres at least one box apart, and each box's bottom at or above a floor top
+    /// with no floor cutting through it).
+    #[test]
+    fn many_pyramids_do_not_overlap() {
+        let spec = PYRAMIDS.iter().find(|p| p.name == "many_pyramids").unwrap();
+        let c = spec.centres();
+        assert_eq!(c.len(), 100 * 55);
+        let mut sorted = c.clone();
+        sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (i, a) in sorted.iter().enumerate() {
+            for b in sorted[i + 1..]
+                .iter()
+                .take_while(|b| b.0 - a.0 < BOX - 1e-9)
+            {
+                assert!((a.1 - b.1).abs() >= BOX - 1e-9, "{a:?} overlaps {b:?}");
+            }
+        }
+        let tops = spec.floor_tops();
+        for &(_, y) in &c {
+            let bottom = y - 0.5 * BOX;
+            assert!(
+                tops.iter()
+                    .any(|&t| (bottom - t) > -1e-9 && bottom - t < 10.0 * BOX)
+            );
+            assert!(
+                tops.iter()
+                    .all(|&t| bottom >= t - 1e-9 || y + 0.5 * BOX <= t - FLOOR.1 + 1e-9)
+            );
+        }
     }
 
     #[test]

@@ -8,7 +8,7 @@
 
 use crate::harness::Timing;
 use crate::pe_scenes::{self, PeConfig};
-use crate::scene::{Metric, Pendulum, chain};
+use crate::scene::{Metric, Pendulum, Pyramid, STACKS, chain};
 use crate::{Outcome, box2d_scenes, rapier_scenes};
 use pe::{ContactSolver, Integrator};
 use plotters::prelude::*;
@@ -35,6 +35,7 @@ fn configurations() -> Vec<(String, Engine)> {
             solver,
             integrator,
             soft_substeps,
+            ..PeConfig::new(solver)
         })
     };
     let mut list = vec![
@@ -80,7 +81,30 @@ struct Scene {
     error: fn(&Metric) -> f64,
 }
 
-fn scenes() -> [Scene; 3] {
+/// A stack at step `h` for 10 s.
+fn stack(spec: &Pyramid, engine: Engine, h: f64) -> Outcome {
+    let spec = Pyramid {
+        steps: (10.0 / h).round() as usize,
+        ..*spec
+    };
+    match engine {
+        Engine::Pe(c) => pe_scenes::pyramid(c, &spec, h),
+        Engine::Rapier { iterations } => rapier_scenes::pyramid(&spec, h, iterations),
+        Engine::Box2d { substeps } => box2d_scenes::pyramid(&spec, h, substeps),
+    }
+}
+
+/// A stack's error: how far its top box slid sideways plus the most it sank, in boxes.
+fn stack_error(m: &Metric) -> f64 {
+    match *m {
+        Metric::Pyramid {
+            top_drift, top_sag, ..
+        } => top_drift + top_sag.max(0.0),
+        _ => f64::NAN,
+    }
+}
+
+fn scenes() -> [Scene; 5] {
     [
         Scene {
             name: "pendulum90",
@@ -123,6 +147,18 @@ fn scenes() -> [Scene; 3] {
                 Metric::Bounce { error, .. } => error.abs(),
                 _ => f64::NAN,
             },
+        },
+        Scene {
+            name: "stack10",
+            error_name: "top box's sideways drift + sag over 10 s (boxes)",
+            run: |engine, h| stack(&STACKS[0], engine, h),
+            error: stack_error,
+        },
+        Scene {
+            name: "stack20",
+            error_name: "top box's sideways drift + sag over 10 s (boxes)",
+            run: |engine, h| stack(&STACKS[1], engine, h),
+            error: stack_error,
         },
     ]
 }
@@ -252,6 +288,8 @@ fn plot(
         .bold_line_style(BLACK.mix(0.15))
         .x_desc("compute time per simulated second (ms)")
         .y_desc(scene.error_name)
+        .x_label_formatter(&|v| power_label(*v))
+        .y_label_formatter(&|v| power_label(*v))
         .draw()?;
     for (k, (label, points)) in series.iter().enumerate() {
         let color = Palette99::pick(k).to_rgba();
@@ -283,4 +321,32 @@ fn plot(
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// A log axis's tick as a short number: plotters puts ticks at powers of ten computed in
+/// floating point (1e-5 comes out as 9.999999999999999e-6), so round to three figures.
+fn power_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let rounded: f64 = format!("{v:.2e}").parse().unwrap_or(v);
+    if (1e-3..1e4).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::power_label;
+
+    #[test]
+    fn axis_labels_round_the_floating_point_powers() {
+        assert_eq!(power_label(9.999999999999999e-6), "1e-5");
+        assert_eq!(power_label(0.09999999999999999), "0.1");
+        assert_eq!(power_label(1000.0000000000001), "1000");
+        assert_eq!(power_label(1e-9), "1e-9");
+        assert_eq!(power_label(25.0), "25");
+    }
 }
