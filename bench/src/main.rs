@@ -31,7 +31,11 @@ impl Outcome {
 }
 
 /// The pe solvers compared; the peers are the references for the time ratios.
-const PE_SOLVERS: [ContactSolver; 2] = [ContactSolver::Exact, ContactSolver::Soft];
+const PE_SOLVERS: [ContactSolver; 3] = [
+    ContactSolver::Exact,
+    ContactSolver::Soft,
+    ContactSolver::Auto,
+];
 
 /// The peer engines, in the order of `Row::peers`.
 const PEERS: [&str; 2] = ["rapier2d", "Box2D v3"];
@@ -266,7 +270,7 @@ fn report(rows: &[Row], narrow: &[NarrowRow], elapsed: Duration, load: &str) -> 
          every body with `can_sleep(false)`; Box2D v3 through boxdd {} (Box2D's C \
          sources built by cc, f32, one thread), default world settings with {} substeps, \
          sleeping off.",
-        names.join("` and `"),
+        names.join("`, `"),
         rapier_version(),
         locked_version("boxdd"),
         box2d_scenes::SUBSTEPS

@@ -200,6 +200,17 @@ impl Body {
         self.inv_mass = 0.0;
         self.inv_inertia = 0.0;
     }
+    /// Held still for one pass of a step that moves the rest of the world (a body of the
+    /// other solver's islands under `ContactSolver::Auto`); unlike sleep, it keeps its
+    /// velocity, so contacts with it see it moving.
+    pub(crate) fn hold(&mut self) {
+        self.inv_mass = 0.0;
+        self.inv_inertia = 0.0;
+    }
+    pub(crate) fn release(&mut self) {
+        self.inv_mass = self.inv_mass();
+        self.inv_inertia = self.inv_inertia();
+    }
     pub(crate) fn wake(&mut self) {
         self.asleep = false;
         self.still_time = 0.0;

@@ -179,11 +179,21 @@ pub struct World {
     ignored_pairs: Vec<(u32, u32)>,
     body_motors: Vec<(BodyHandle, BodyMotor)>,
     manifolds: Vec<Manifold>,
-    manifold_cache: ManifoldCache,
+    /// Each pipeline's manifolds kept for reuse (see `Pipeline`).
+    manifold_caches: [ManifoldCache; 2],
     contacts: Vec<Contact>,
     /// Per body: the island it fell asleep with (woken together).
     sleep_labels: Vec<u32>,
     scratch: Scratch,
+}
+
+/// The two stage lists of a step: impulses (`sequential`, `thesis`, `exact`) and the soft
+/// step. Under `auto` both run in one step on different islands, each finding its own
+/// contacts, so each keeps its own manifolds for reuse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pipeline {
+    Impulses = 0,
+    Soft = 1,
 }
 
 /// Seconds an island must stay still before it sleeps.
@@ -220,6 +230,16 @@ struct Scratch {
     toi_scratch: WorldPolygon,
     /// Static bodies' outlines and bounds, for continuous collision.
     obstacles: Vec<(WorldPolygon, Aabb)>,
+    /// `auto`: the islands' links and row counts, which bodies are in big islands, the
+    /// bodies held in the current pass, the exact pass's contacts while the soft pass
+    /// runs, and both passes' island reports.
+    auto_links: Vec<(u32, u32, usize)>,
+    island_rows: Vec<usize>,
+    in_big_island: Vec<bool>,
+    held: Vec<u32>,
+    exact_contacts: Vec<Contact>,
+    exact_manifolds: Vec<Manifold>,
+    auto_reports: Vec<IslandReport>,
 }
 
 impl World {
@@ -467,11 +487,14 @@ impl World {
                     .map_or((Vec2::zeros(), 0.0), |b| (b.position, b.angle))
             }));
         }
-        if self.settings.contact_solver == ContactSolver::Soft {
-            self.step_soft(dt);
-        } else {
-            self.step_impulses(dt);
+        self.apply_motor_torques(dt);
+        match self.settings.contact_solver {
+            ContactSolver::Soft => self.step_soft(dt),
+            ContactSolver::Auto => self.step_auto(dt),
+            _ => self.step_impulses(dt),
         }
+        self.clear_forces();
+        self.step_count += 1;
         if self.settings.continuous {
             self.stop_at_impact();
         }
@@ -753,7 +776,6 @@ impl World {
     }
 
     fn step_impulses(&mut self, dt: f64) {
-        self.apply_motor_torques(dt);
         self.repair_broken_joints(dt);
         let mut substeps = self.substeps_for(dt);
         // A joint still broken is being repaired on purpose over several steps; only
@@ -766,7 +788,7 @@ impl World {
             for _ in 0..substeps {
                 self.correct_joint_velocities(h);
                 self.integrate_velocities(h);
-                self.detect_contacts(h);
+                self.detect_contacts(h, Pipeline::Impulses);
                 self.push_apart();
                 self.solve_constraints(h);
                 self.place_bounces_at_impact(h);
@@ -789,8 +811,6 @@ impl World {
             self.restore_state();
             substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
         }
-        self.clear_forces();
-        self.step_count += 1;
     }
 
     fn for_each_motor(&mut self, f: impl Fn(&mut JointMotor)) {
@@ -886,12 +906,134 @@ impl World {
         }
     }
 
+    /// The solver the impulse stage list runs as: `auto` runs it as `exact`.
+    fn impulse_solver(&self) -> ContactSolver {
+        match self.settings.contact_solver {
+            ContactSolver::Auto => ContactSolver::Exact,
+            solver => solver,
+        }
+    }
+
+    /// `auto`: islands (from the last step's contacts and the joints) of more than
+    /// `dense_row_limit` LCP rows go to the soft step, the rest to `exact`. Each solver's
+    /// pass holds the other's bodies still (they keep their velocities), so a contact
+    /// between islands of different solvers acts one way for a step; the next step finds
+    /// them one island. Contacts and island reports of both passes are kept.
+    fn step_auto(&mut self, dt: f64) {
+        let (small, big) = self.mark_big_islands();
+        if !big {
+            self.step_impulses(dt);
+            self.scratch
+                .auto_reports
+                .clone_from(&self.scratch.simultaneous.reports);
+            return;
+        }
+        if !small {
+            self.step_soft(dt);
+            self.scratch
+                .auto_reports
+                .clone_from(&self.scratch.soft.reports);
+            return;
+        }
+        self.hold_where(true);
+        self.step_impulses(dt);
+        self.release_held();
+        let s = &mut self.scratch;
+        std::mem::swap(&mut s.exact_contacts, &mut self.contacts);
+        std::mem::swap(&mut s.exact_manifolds, &mut self.manifolds);
+        self.hold_where(false);
+        self.step_soft(dt);
+        self.release_held();
+        let s = &mut self.scratch;
+        s.auto_reports.clone_from(&s.simultaneous.reports);
+        s.auto_reports.extend_from_slice(&s.soft.reports);
+        // A pair across the two passes was found by both: keep the exact pass's.
+        let exact_pairs = &s.exact_manifolds;
+        let seen = |a: u32, b: u32| {
+            exact_pairs
+                .binary_search_by(|m| (m.body_a.0, m.body_b.0).cmp(&(a, b)))
+                .is_ok()
+        };
+        self.contacts.retain(|c| !seen(c.body_a, c.body_b));
+        self.manifolds.retain(|m| !seen(m.body_a.0, m.body_b.0));
+        self.contacts.splice(0..0, s.exact_contacts.drain(..));
+        self.manifolds.splice(0..0, s.exact_manifolds.drain(..));
+    }
+
+    /// Marks each moving body whose island has more than `dense_row_limit` LCP rows (two
+    /// per contact point and per pin, one per motor), islands joined by the last step's
+    /// contacts and the joints. Returns whether some moving body is in a small island and
+    /// whether some is in a big one.
+    fn mark_big_islands(&mut self) -> (bool, bool) {
+        let n = self.bodies.len();
+        let bodies = &self.bodies;
+        let moving = |i: u32| bodies[i as usize].as_ref().is_some_and(|b| !b.is_fixed());
+        let s = &mut self.scratch;
+        let mut links: Vec<(u32, u32, usize)> = std::mem::take(&mut s.auto_links);
+        links.clear();
+        links.extend(self.contacts.iter().map(|c| (c.body_a, c.body_b, 2)));
+        for j in self.joints.iter().flatten() {
+            let rows = 2 + usize::from(j.motor.is_some_and(|m| m.enabled));
+            let b = j.body_b.map_or(j.body_a.0, |h| h.0);
+            links.push((j.body_a.0, b, rows));
+        }
+        s.sleep_union.reset(n);
+        for &(a, b, _) in &links {
+            if moving(a) && moving(b) {
+                s.sleep_union.union(a, b);
+            }
+        }
+        s.island_rows.clear();
+        s.island_rows.resize(n, 0);
+        for &(a, b, rows) in &links {
+            let end = if moving(a) { a } else { b };
+            if moving(end) {
+                let root = s.sleep_union.find(end);
+                s.island_rows[root as usize] += rows;
+            }
+        }
+        s.auto_links = links;
+        s.in_big_island.clear();
+        let (mut small, mut big) = (false, false);
+        for i in 0..n as u32 {
+            let is_big = moving(i)
+                && s.island_rows[s.sleep_union.find(i) as usize] > self.settings.dense_row_limit;
+            s.in_big_island.push(is_big);
+            big |= is_big;
+            small |= moving(i) && !is_big;
+        }
+        (small, big)
+    }
+
+    /// Holds every moving body whose island is (`big`) or is not (`!big`) big.
+    fn hold_where(&mut self, big: bool) {
+        let s = &mut self.scratch;
+        s.held.clear();
+        for (i, body) in self.bodies.iter_mut().enumerate() {
+            if let Some(b) = body
+                && !b.is_fixed()
+                && s.in_big_island[i] == big
+            {
+                b.hold();
+                s.held.push(i as u32);
+            }
+        }
+    }
+
+    fn release_held(&mut self) {
+        for &i in &self.scratch.held {
+            if let Some(b) = self.bodies[i as usize].as_mut() {
+                b.release();
+            }
+        }
+        self.scratch.held.clear();
+    }
+
     /// The soft step has its own stage list: forces, contacts found once, then substeps
     /// that integrate and solve together (see `solver::soft`).
     fn step_soft(&mut self, dt: f64) {
-        self.apply_motor_torques(dt);
         self.scratch.start_velocities.clear(); // forces act inside the substeps
-        self.detect_contacts(dt);
+        self.detect_contacts(dt, Pipeline::Soft);
         self.gather_solver_bodies();
         let s = &mut self.scratch;
         s.accelerations.clear();
@@ -916,8 +1058,6 @@ impl World {
             restitution_threshold(self.gravity, dt),
         );
         self.scatter_solver_bodies();
-        self.clear_forces();
-        self.step_count += 1;
     }
 
     /// Copies the bodies into the solver array, the static world last, and resolves the
@@ -1038,7 +1178,7 @@ impl World {
     ///
     /// Each body's bounds and contact margin grow by how far it can move this step, so a
     /// contact is found (as a speculative one) before the bodies meet, however fast.
-    fn detect_contacts(&mut self, dt: f64) {
+    fn detect_contacts(&mut self, dt: f64, pipeline: Pipeline) {
         let s = &mut self.scratch;
         s.polygons
             .resize_with(self.bodies.len(), WorldPolygon::default);
@@ -1083,7 +1223,7 @@ impl World {
         self.contacts.clear();
         let tie = self.settings.tie_tolerance();
         let reuse_tolerance = self.settings.manifold_reuse_tolerance();
-        let cache = &mut self.manifold_cache;
+        let cache = &mut self.manifold_caches[pipeline as usize];
         if self.settings.reuse_manifolds {
             cache.begin_step();
         } else {
@@ -1155,7 +1295,7 @@ impl World {
     /// The thesis removes overlap directly: each pair is pushed apart along its normal by
     /// its depth, shared by inverse mass (SPEC §3.1). Positions only.
     fn push_apart(&mut self) {
-        if self.settings.contact_solver == ContactSolver::Exact {
+        if self.impulse_solver() == ContactSolver::Exact {
             return; // the exact solver removes depth by split impulses instead
         }
         for m in &self.manifolds {
@@ -1182,6 +1322,7 @@ impl World {
     /// Stages 5–6: contact impulses (with pins and motors in the exact solver), then joint
     /// position prediction, then (exact solver) the split-impulse depth correction.
     fn solve_constraints(&mut self, dt: f64) {
+        let solver = self.impulse_solver();
         self.gather_solver_bodies();
         let s = &mut self.scratch;
         let targets = VelocityTargets {
@@ -1190,9 +1331,8 @@ impl World {
             friction: true,
             close_joint_gaps: true,
         };
-        let solver = self.settings.contact_solver;
         match solver {
-            ContactSolver::Sequential | ContactSolver::Soft => {
+            ContactSolver::Sequential | ContactSolver::Soft | ContactSolver::Auto => {
                 s.simultaneous.reports.clear();
                 solve_sequential(
                     &mut self.contacts,
@@ -1246,10 +1386,10 @@ impl World {
     /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
     /// `thesis` the last substep's islands; under `soft` the step's.
     pub fn island_reports(&self) -> &[IslandReport] {
-        if self.settings.contact_solver == ContactSolver::Soft {
-            &self.scratch.soft.reports
-        } else {
-            &self.scratch.simultaneous.reports
+        match self.settings.contact_solver {
+            ContactSolver::Soft => &self.scratch.soft.reports,
+            ContactSolver::Auto => &self.scratch.auto_reports,
+            _ => &self.scratch.simultaneous.reports,
         }
     }
 

@@ -60,14 +60,19 @@ pub enum ContactSolver {
     /// for, pins and joint motors; penetration removed by a split-impulse position pass.
     #[default]
     Exact,
+    /// Per island: `Exact` for islands of up to `StepSettings::dense_row_limit` LCP rows
+    /// (robots, small piles), where it pivots, and `Soft` for bigger ones, where it would
+    /// fall back to Gauss–Seidel sweeps (see `World::step`).
+    Auto,
 }
 
 impl ContactSolver {
-    pub const ALL: [ContactSolver; 4] = [
+    pub const ALL: [ContactSolver; 5] = [
         ContactSolver::Sequential,
         ContactSolver::Thesis,
         ContactSolver::Soft,
         ContactSolver::Exact,
+        ContactSolver::Auto,
     ];
 
     pub fn name(self) -> &'static str {
@@ -76,6 +81,7 @@ impl ContactSolver {
             ContactSolver::Thesis => "thesis",
             ContactSolver::Soft => "soft",
             ContactSolver::Exact => "exact",
+            ContactSolver::Auto => "auto",
         }
     }
 

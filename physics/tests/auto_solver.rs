@@ -1,0 +1,173 @@
+//! `ContactSolver::Auto` (issue 8): exact for small islands and robots, the soft step for
+//! big piles, in one world. Metre-sized bodies, g = 10 m/s², h = 1/60 s.
+
+use pe::solver::simultaneous::IslandMethod;
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, JointDef, JointMotor, Vec2, World};
+
+const H: f64 = 1.0 / 60.0;
+
+fn floor(w: &mut World) {
+    let floor = ConvexPolygon::rectangle(200.0, 1.0).unwrap();
+    w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+        .unwrap();
+}
+
+/// A 10-row pyramid of unit boxes at x = 0 (55 boxes, some 200 LCP rows: a big island).
+fn pyramid(w: &mut World) -> Vec<(BodyHandle, Vec2)> {
+    let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let mut boxes = Vec::new();
+    for row in 0..10 {
+        for i in 0..10 - row {
+            let centre = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
+            let b = w
+                .add_body(BodyDef::new(unit.clone(), 1.0).at(centre, 0.0))
+                .unwrap();
+            boxes.push((b, centre));
+        }
+    }
+    boxes
+}
+
+/// A robot away from the pile: a three-link arm pinned to the world at (40, −6) with a
+/// motor at its shoulder, and a box resting on the floor under it (small islands).
+fn robot(w: &mut World) -> Vec<BodyHandle> {
+    let link = ConvexPolygon::rectangle(1.0, 0.2).unwrap();
+    let mut bodies = Vec::new();
+    let mut previous = None;
+    for i in 0..3 {
+        let x = 40.0 + i as f64;
+        let b = w
+            .add_body(BodyDef::new(link.clone(), 2.0).at(Vec2::new(x + 0.5, -6.0), 0.0))
+            .unwrap();
+        let mut pin = JointDef::new(b, previous, Vec2::new(x, -6.0));
+        if i == 0 {
+            pin.motor = Some(JointMotor::new(1.5, 50.0));
+        }
+        w.add_joint(pin).unwrap();
+        bodies.push(b);
+        previous = Some(b);
+    }
+    let crate_box = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    bodies.push(
+        w.add_body(BodyDef::new(crate_box, 1.0).at(Vec2::new(38.0, -0.5), 0.0))
+            .unwrap(),
+    );
+    bodies
+}
+
+fn world(solver: ContactSolver) -> World {
+    let mut w = World::new(Vec2::new(0.0, 10.0));
+    w.settings.contact_solver = solver;
+    w.friction = 0.6;
+    w
+}
+
+/// Under `auto` the pile's island goes to the soft step and the robot's to `exact`: the
+/// reports name both, the robot moves bit for bit as it does alone under `exact`, and the
+/// pile stands as it does under `soft`.
+#[test]
+fn auto_solves_the_robot_exactly_and_the_pile_by_the_soft_step() {
+    let mut mixed = world(ContactSolver::Auto);
+    floor(&mut mixed);
+    let boxes = pyramid(&mut mixed);
+    let robot_in_mixed = robot(&mut mixed);
+    let mut alone = world(ContactSolver::Exact);
+    floor(&mut alone);
+    let robot_alone = robot(&mut alone);
+    let mut soft = world(ContactSolver::Soft);
+    floor(&mut soft);
+    let soft_boxes = pyramid(&mut soft);
+
+    for step in 0..300 {
+        mixed.step(H);
+        alone.step(H);
+        soft.step(H);
+        for (&a, &b) in robot_in_mixed.iter().zip(&robot_alone) {
+            let (a, b) = (mixed.body(a).unwrap(), alone.body(b).unwrap());
+            assert_eq!(a.state(), b.state(), "robot differs at step {step}");
+        }
+    }
+    // The motor turned the arm: the robot did something worth comparing.
+    let shoulder = mixed.body(robot_in_mixed[0]).unwrap();
+    assert!(shoulder.angle.abs() > 1.0, "arm turned {}", shoulder.angle);
+
+    let reports = mixed.island_reports();
+    let robot_arm = reports
+        .iter()
+        .find(|r| r.joints == 3)
+        .expect("the arm's island");
+    assert_eq!(robot_arm.method, IslandMethod::Pivoting);
+    let crate_island = reports
+        .iter()
+        .find(|r| r.joints == 0 && r.contacts == 2)
+        .expect("the box on the floor");
+    assert_eq!(crate_island.method, IslandMethod::Pivoting);
+    let pile = reports
+        .iter()
+        .find(|r| r.contacts > 48)
+        .expect("the pile's island");
+    assert!(
+        matches!(
+            pile.method,
+            IslandMethod::SoftPointByPoint | IslandMethod::SoftLcp
+        ),
+        "{:?}",
+        pile.method
+    );
+    // Both passes' contacts are reported: the box's two and the pile's.
+    let touching = |w: &World, b: BodyHandle| {
+        w.contacts()
+            .iter()
+            .filter(|c| c.body_a == b.0 || c.body_b == b.0)
+            .count()
+    };
+    assert_eq!(touching(&mixed, robot_in_mixed[3]), 2);
+    assert!(mixed.contacts().len() > 100);
+
+    // The pile: after the first step (solved exactly, before any contact was known), the
+    // soft step; its top box stays within 1% of a width of where the all-soft world's is.
+    let top = |w: &World, b: &[(BodyHandle, Vec2)]| w.body(b.last().unwrap().0).unwrap().position;
+    let start = boxes.last().unwrap().1;
+    let (mixed_top, soft_top) = (top(&mixed, &boxes), top(&soft, &soft_boxes));
+    assert!((mixed_top.x - start.x).abs() < 0.01, "{mixed_top:?}");
+    assert!(
+        (mixed_top - soft_top).norm() < 0.01,
+        "{mixed_top:?} {soft_top:?}"
+    );
+}
+
+/// A lone box falling onto the pile is a small island (exact) until it lands, then part
+/// of the pile's island (soft): the hand-over neither loses it nor lets it sink in.
+#[test]
+fn a_box_landing_on_the_pile_joins_the_soft_island() {
+    let mut w = world(ContactSolver::Auto);
+    floor(&mut w);
+    let boxes = pyramid(&mut w);
+    let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let top = boxes.last().unwrap().1;
+    let dropped = w
+        .add_body(BodyDef::new(unit, 1.0).at(top - Vec2::new(0.0, 3.0), 0.0))
+        .unwrap();
+    let island_of_dropped = |w: &World| {
+        w.island_reports()
+            .iter()
+            .find(|r| r.contacts > 48)
+            .map(|r| r.method)
+    };
+    for _ in 0..180 {
+        w.step(H);
+    }
+    let rest = w.body(dropped).unwrap().position;
+    // Resting on the top box: one box above it, within the soft step's overlap.
+    let below = w.body(boxes.last().unwrap().0).unwrap().position;
+    assert!(
+        (below.y - rest.y - 1.0).abs() < 0.02,
+        "{rest:?} on {below:?}"
+    );
+    assert!((rest.x - below.x).abs() < 0.05, "{rest:?} on {below:?}");
+    assert!(w.body(dropped).unwrap().velocity.norm() < 0.05);
+    assert!(matches!(
+        island_of_dropped(&w),
+        Some(IslandMethod::SoftPointByPoint | IslandMethod::SoftLcp)
+    ));
+}
