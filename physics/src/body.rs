@@ -200,16 +200,21 @@ impl Body {
         self.inv_mass = 0.0;
         self.inv_inertia = 0.0;
     }
-    /// Held still for one pass of a step that moves the rest of the world (a body of the
-    /// other solver's islands under `ContactSolver::Auto`); unlike sleep, it keeps its
-    /// velocity, so contacts with it see it moving.
-    pub(crate) fn hold(&mut self) {
+    /// Held still, as if asleep, for one pass of a step that moves the rest of the world
+    /// (a body of the other solver's islands under `ContactSolver::Auto`). Returns its
+    /// velocity, for `release`: a held body that kept it would look to the pass as if it
+    /// were still to move this step, which it has done or will do in its own pass.
+    pub(crate) fn hold(&mut self) -> (Vec2, f64) {
         self.inv_mass = 0.0;
         self.inv_inertia = 0.0;
+        let velocity = (self.velocity, self.angular_velocity);
+        (self.velocity, self.angular_velocity) = (Vec2::zeros(), 0.0);
+        velocity
     }
-    pub(crate) fn release(&mut self) {
+    pub(crate) fn release(&mut self, (velocity, angular_velocity): (Vec2, f64)) {
         self.inv_mass = self.inv_mass();
         self.inv_inertia = self.inv_inertia();
+        (self.velocity, self.angular_velocity) = (velocity, angular_velocity);
     }
     pub(crate) fn wake(&mut self) {
         self.asleep = false;
