@@ -9,6 +9,7 @@ fn main() {
     let solver = match args.next().as_deref() {
         Some("exact") => ContactSolver::Exact,
         Some("thesis") => ContactSolver::Thesis,
+        Some("auto") => ContactSolver::Auto,
         _ => ContactSolver::Soft,
     };
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);

@@ -241,6 +241,9 @@ struct Scratch {
     exact_contacts: Vec<Contact>,
     exact_manifolds: Vec<Manifold>,
     auto_reports: Vec<IslandReport>,
+    /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
+    /// the next contact detection at the same step length: set by `auto` only.
+    candidates_current: bool,
 }
 
 impl World {
@@ -931,6 +934,9 @@ impl World {
             return;
         }
         if !small {
+            // No body is held and none has moved: the soft step's broad phase would find
+            // the candidate pairs just found.
+            self.scratch.candidates_current = true;
             self.step_soft(dt);
             self.scratch
                 .auto_reports
@@ -1230,7 +1236,9 @@ impl World {
     }
 
     fn detect_contacts(&mut self, dt: f64, pipeline: Pipeline) {
-        self.find_candidate_pairs(dt);
+        if !std::mem::take(&mut self.scratch.candidates_current) {
+            self.find_candidate_pairs(dt);
+        }
         let s = &mut self.scratch;
         let margin = self.settings.contact_margin();
         self.manifolds.clear();
