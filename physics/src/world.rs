@@ -919,11 +919,12 @@ impl World {
     }
 
     /// `auto`: islands of more than `dense_row_limit` LCP rows go to the soft step, the
-    /// rest to `exact`. Each solver's pass holds the other's bodies still. Islands are joined by the broad phase's candidate pairs of this step,
-    /// not only by last step's contacts, so bodies that can touch during the step are in
-    /// one pass: a box falling onto a pile joins the pile's pass before it lands. (Joined
-    /// by last step's contacts only, the landing step acted one way, and the smash scene
-    /// lost 0.7% of its momentum.) Contacts and island reports of both passes are kept.
+    /// rest to `exact`. Each solver's pass holds the other's bodies still. Islands are
+    /// joined by the broad phase's candidate pairs of this step, not only by last step's
+    /// contacts, so bodies that can touch during the step are in one pass: a box falling
+    /// onto a pile joins the pile's pass before it lands. (Joined by last step's contacts
+    /// only, the landing step acted one way, and the smash scene lost 0.7% of its
+    /// momentum.) Contacts and island reports of both passes are kept.
     fn step_auto(&mut self, dt: f64) {
         let (small, big) = self.mark_big_islands(dt);
         if !big {
@@ -1185,10 +1186,6 @@ impl World {
         }
     }
 
-    /// Broad phase, then SAT on each candidate pair (SPEC §3.1).
-    ///
-    /// Each body's bounds and contact margin grow by how far it can move this step, so a
-    /// contact is found (as a speculative one) before the bodies meet, however fast.
     /// World outlines, each body's reach this step and poses, and the broad phase's
     /// candidate pairs: bodies whose bounds, grown by the margin and by how far each can
     /// move in `dt`, overlap (pairs of fixed bodies and pairs kept apart left out).
@@ -1235,6 +1232,11 @@ impl World {
         s.broad_phase.pairs(&s.boxes, wanted, &mut s.pairs);
     }
 
+    /// Broad phase, then SAT on each candidate pair (SPEC §3.1), or the pair's last
+    /// manifold where it has barely moved (`collide::reuse`).
+    ///
+    /// Each body's bounds and contact margin grow by how far it can move this step, so a
+    /// contact is found (as a speculative one) before the bodies meet, however fast.
     fn detect_contacts(&mut self, dt: f64, pipeline: Pipeline) {
         if !std::mem::take(&mut self.scratch.candidates_current) {
             self.find_candidate_pairs(dt);
@@ -1406,7 +1408,7 @@ impl World {
 
     /// How each island was solved in the last step: by which method (see
     /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
-    /// `thesis` the last substep's islands; under `soft` the step's.
+    /// `thesis` the last substep's islands; under `soft` the step's; under `auto` both passes'.
     pub fn island_reports(&self) -> &[IslandReport] {
         match self.settings.contact_solver {
             ContactSolver::Soft => &self.scratch.soft.reports,
