@@ -105,6 +105,10 @@ struct PointConstraint {
     r_a: Vec2,
     r_b: Vec2,
     normal: Vec2,
+    /// The anchors' levers about the normal and the tangent (`r × n`, `r × t` on A and
+    /// on B), fixed for the step like the anchors: a row's velocity and impulse use them
+    /// instead of crossing the arms again at every pass.
+    levers: PointLevers,
     /// Separation at the start, minus the anchors' part, so that the current separation is
     /// `n·(Δ(p_a + r_a) − Δ(p_b + r_b)) + base_separation`.
     base_separation: f64,
@@ -133,6 +137,12 @@ struct NormalBlock {
     k12: f64,
     k22: f64,
     inverse: (f64, f64, f64),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct PointLevers {
+    normal: (f64, f64),
+    tangent: (f64, f64),
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
@@ -297,6 +307,10 @@ impl SoftStepSolver {
                 r_a,
                 r_b,
                 normal: c.normal,
+                levers: PointLevers {
+                    normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
+                    tangent: (cross(r_a, t), cross(r_b, t)),
+                },
                 base_separation: -c.depth,
                 normal_mass: inverse(k(c.normal)),
                 tangent_mass: inverse(k(t)),
@@ -689,16 +703,26 @@ impl BodyPair {
         (bb.v, bb.w) = (self.vb, self.wb);
     }
 
-    /// The velocity of anchor `r_a` on A relative to anchor `r_b` on B.
+    /// The velocity of a point's anchors (A relative to B, at the anchors fixed for the
+    /// step) along `direction`, with the anchors' `levers` about it.
     #[inline(always)]
-    fn relative_velocity(&self, r_a: Vec2, r_b: Vec2) -> Vec2 {
-        (self.va + cross_scalar(self.wa, r_a)) - (self.vb + cross_scalar(self.wb, r_b))
+    fn velocity_along(&self, direction: Vec2, (lever_a, lever_b): (f64, f64)) -> f64 {
+        (self.va - self.vb).dot(&direction) + self.wa * lever_a - self.wb * lever_b
     }
 
-    /// A point's normal velocity at its fixed anchors (A relative to B).
+    /// A point's normal velocity.
     #[inline(always)]
     fn normal_velocity(&self, p: &PointConstraint) -> f64 {
-        self.relative_velocity(p.r_a, p.r_b).dot(&p.normal)
+        self.velocity_along(p.normal, p.levers.normal)
+    }
+
+    /// `impulse` along `direction` on A and its opposite on B, with the anchors' levers.
+    #[inline(always)]
+    fn apply_along(&mut self, direction: Vec2, (lever_a, lever_b): (f64, f64), impulse: f64) {
+        self.va += direction * (impulse * self.inv_mass.0);
+        self.wa += self.inv_inertia.0 * lever_a * impulse;
+        self.vb -= direction * (impulse * self.inv_mass.1);
+        self.wb -= self.inv_inertia.1 * lever_b * impulse;
     }
 
     /// `impulse` on A at `r_a`, its opposite on B at `r_b`.
@@ -719,7 +743,7 @@ fn apply_normal(pair: &mut BodyPair, p: &mut PointConstraint, total: f64) {
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
     p.max_normal_impulse = p.max_normal_impulse.max(delta);
-    pair.apply(p.r_a, p.r_b, p.normal * delta);
+    pair.apply_along(p.normal, p.levers.normal, delta);
 }
 
 /// The velocity a point's normal row aims at (minus bias) and its softness: speculative
@@ -774,12 +798,12 @@ fn solve_point(
 #[inline(always)]
 fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
     let t = perp(p.normal);
-    let vt = pair.relative_velocity(p.r_a, p.r_b).dot(&t);
+    let vt = pair.velocity_along(t, p.levers.tangent);
     let limit = p.friction * p.normal_impulse;
     let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
-    pair.apply(p.r_a, p.r_b, t * delta);
+    pair.apply_along(t, p.levers.tangent, delta);
 }
 
 /// Two points of one manifold: normals together (when both rows have the same softness),
@@ -1185,7 +1209,7 @@ impl ContactLcp {
                     normal_target(bodies, p, inv_h, soft, max_push, use_bias);
                 let pair = BodyPair::load(bodies, p.a, p.b);
                 let vn = approach(&pair, p, separation);
-                let vt = pair.relative_velocity(p.r_a, p.r_b).dot(&perp(p.normal));
+                let vt = pair.velocity_along(perp(p.normal), p.levers.tangent);
                 self.b.extend([vn - target, vt]);
                 self.x.extend([p.normal_impulse, p.tangent_impulse]);
                 self.lo.extend([0.0, 0.0]);
@@ -1218,7 +1242,7 @@ impl ContactLcp {
                 apply_normal(&mut pair, p, self.x[2 * i]);
                 let delta = self.x[2 * i + 1] - p.tangent_impulse;
                 p.tangent_impulse = self.x[2 * i + 1];
-                pair.apply(p.r_a, p.r_b, perp(p.normal) * delta);
+                pair.apply_along(perp(p.normal), p.levers.tangent, delta);
                 pair.store(bodies);
             }
         }
