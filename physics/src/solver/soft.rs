@@ -143,6 +143,8 @@ struct NormalBlock {
 struct PointLevers {
     normal: (f64, f64),
     tangent: (f64, f64),
+    /// `r · n` on A and on B: how far each anchor reaches along the normal.
+    reach: (f64, f64),
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
@@ -310,6 +312,7 @@ impl SoftStepSolver {
                 levers: PointLevers {
                     normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
                     tangent: (cross(r_a, t), cross(r_b, t)),
+                    reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
                 },
                 base_separation: -c.depth,
                 normal_mass: inverse(k(c.normal)),
@@ -761,9 +764,13 @@ fn normal_target(
     // Current separation: how the anchors moved along the normal since the start. The
     // impulse acts at the anchors fixed for the step (as warm starting applies it), so
     // that every substep pushes through the same lever.
-    let moved =
-        (a.dp + rotate_delta(a.dq, p.r_a) - p.r_a) - (b.dp + rotate_delta(b.dq, p.r_b) - p.r_b);
-    let separation = moved.dot(&p.normal) + p.base_separation;
+    // A body turned by q moves its anchor r by q·r − r, whose part along n is
+    // (cos − 1)(r·n) + sin (r × n): the anchor's reach along the normal and its lever.
+    let turned = |q: Rot, reach: f64, lever: f64| (q.cos - 1.0) * reach + q.sin * lever;
+    let (reach, lever) = (p.levers.reach, p.levers.normal);
+    let separation = (a.dp - b.dp).dot(&p.normal) + turned(a.dq, reach.0, lever.0)
+        - turned(b.dq, reach.1, lever.1)
+        + p.base_separation;
     if separation > 0.0 {
         (-separation * inv_h, (1.0, 0.0), separation)
     } else if use_bias {
