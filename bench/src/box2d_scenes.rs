@@ -64,8 +64,8 @@ fn centre(world: &World, body: BodyId) -> (f64, f64) {
     (f64::from(p.x), f64::from(p.y))
 }
 
-/// The static floor, top face at y = 0, restitution 0 (the pair takes the larger).
-/// The static floor, its top face at height `top`.
+/// The static floor, its top face at height `top`, restitution 0 (the pair takes the
+/// larger).
 fn floor(w: &mut World, top: f64) {
     boxed(
         w,

@@ -62,9 +62,8 @@ fn rectangle(w: f64, h: f64) -> ConvexPolygon {
     ConvexPolygon::rectangle(w, h).expect("positive sizes")
 }
 
-/// The static floor, top face at y = 0. Restitution 1 because pe combines a pair's
-/// restitutions by their minimum: the moving body's own value then applies.
-/// The static floor, its top face at height `top`.
+/// The static floor, its top face at height `top`. Restitution 1 because pe combines a
+/// pair's restitutions by their minimum: the moving body's own value then applies.
 fn floor(w: &mut World, top: f64) {
     let def = BodyDef::new(rectangle(FLOOR.0, FLOOR.1), 0.0)
         .restitution(1.0)

@@ -46,9 +46,8 @@ fn cuboid(w: f64, h: f64, density: f64) -> ColliderBuilder {
     ColliderBuilder::cuboid(0.5 * w as Real, 0.5 * h as Real).density(density as Real)
 }
 
-/// The static floor, top face at y = 0, with the scenes' friction so that rapier's default
-/// averaging of the pair's coefficients gives exactly `FRICTION`.
-/// The static floor, its top face at height `top`.
+/// The static floor, its top face at height `top`, with the scenes' friction so that
+/// rapier's default averaging of the pair's coefficients gives exactly `FRICTION`.
 fn floor(w: &mut PhysicsWorld, top: f64, restitution: f64) {
     let body = RigidBodyBuilder::fixed()
         .translation(point((0.0, top - 0.5 * FLOOR.1)))
