@@ -2,6 +2,7 @@
 
 use robosim::db::Database;
 use robosim::model::Model;
+use robosim::pe::ContactSolver;
 use robosim::sim::Simulation;
 use robosim::sim::trace::Record;
 
@@ -24,10 +25,16 @@ fn every_default_scene_simulates_1000_steps_without_nan() {
                 scene.name
             );
         }
+        // Soft pins are springs (60 Hz): the car pushing the pyramid under `auto` opens its
+        // pins by up to 0.034 px, 4e-4 of the car's length; rigid pins hold to 0.01 px.
+        let tolerance = match sim.world.settings.contact_solver {
+            ContactSolver::Soft | ContactSolver::Auto => 0.05,
+            _ => 0.01,
+        };
         let gap = sim.metrics().max_joint_gap;
         assert!(
-            gap < 0.01,
-            "{}: joints hold to 0.01 px, worst {gap}",
+            gap < tolerance,
+            "{}: joints hold to {tolerance} px, worst {gap}",
             scene.name
         );
     }

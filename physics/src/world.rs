@@ -971,9 +971,11 @@ impl World {
         self.manifolds.splice(0..0, s.exact_manifolds.drain(..));
     }
 
-    /// Marks each moving body whose island has more than `dense_row_limit` LCP rows (two
-    /// per contact point of the last step and per pin, one per motor); islands are joined
-    /// by those contacts, the joints and this step's candidate pairs. Returns whether some
+    /// Marks each moving body whose island has more than `dense_row_limit` LCP rows;
+    /// islands are joined by the last step's contacts, the joints and this step's
+    /// candidate pairs. Rows: two per pin, one per motor, and the larger of two per contact
+    /// point of the last step and two per candidate pair (one point each), so that a pile
+    /// is big from its first step, before any contact is known. Returns whether some
     /// moving body is in a small island and whether some is in a big one.
     fn mark_big_islands(&mut self, dt: f64) -> (bool, bool) {
         self.find_candidate_pairs(dt);
@@ -996,21 +998,32 @@ impl World {
                 s.island_union.union(a, b);
             }
         }
+        // Per root, two counts: pins, motors and last step's contacts; pins, motors and
+        // candidate pairs. (`links` lists the contacts first, then the joints.)
         s.island_rows.clear();
-        s.island_rows.resize(n, 0);
-        for &(a, b, rows) in &links {
+        s.island_rows.resize(2 * n, 0);
+        let contact_links = self.contacts.len();
+        let counted = links.iter().enumerate().map(|(k, &(a, b, rows))| {
+            let columns = if k < contact_links { 0..1 } else { 0..2 };
+            (a, b, rows, columns)
+        });
+        let candidates = s.pairs.iter().map(|&(a, b)| (a, b, 2, 1..2));
+        for (a, b, rows, columns) in counted.chain(candidates) {
             let end = if moving(a) { a } else { b };
             if moving(end) {
-                let root = s.island_union.find(end);
-                s.island_rows[root as usize] += rows;
+                let root = s.island_union.find(end) as usize;
+                for column in columns {
+                    s.island_rows[column * n + root] += rows;
+                }
             }
         }
         s.auto_links = links;
         s.in_big_island.clear();
         let (mut small, mut big) = (false, false);
         for i in 0..n as u32 {
-            let is_big = moving(i)
-                && s.island_rows[s.island_union.find(i) as usize] > self.settings.dense_row_limit;
+            let root = s.island_union.find(i) as usize;
+            let rows = s.island_rows[root].max(s.island_rows[n + root]);
+            let is_big = moving(i) && rows > self.settings.dense_row_limit;
             s.in_big_island.push(is_big);
             big |= is_big;
             small |= moving(i) && !is_big;

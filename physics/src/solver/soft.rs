@@ -358,6 +358,13 @@ impl SoftStepSolver {
         self.joints.clear();
         for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
+            // A pin between two fixed bodies (asleep, or held for the other solver's pass
+            // under `auto`) can do nothing: it is left out, so neither its island nor its
+            // motor's reading (the other pass's) is touched.
+            let fixed = |b: &SolverBody| b.inv_mass == 0.0 && b.inv_inertia == 0.0;
+            if fixed(a) && fixed(b) {
+                continue;
+            }
             let (r_a, r_b) = j.arms((a.angle, b.angle));
             let (impulse, motor_impulse) =
                 match self.joint_memory.binary_search_by(|m| m.0.cmp(&j.joint)) {
