@@ -4,7 +4,7 @@ use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact};
 use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
-use crate::math::{Rot, Vec2};
+use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
 use crate::solver::joint::{
@@ -226,8 +226,10 @@ struct Scratch {
     accelerations: Vec<(Vec2, f64)>,
     /// Every body's centroid and angle when the step began, for continuous collision.
     step_start: Vec<(Vec2, f64)>,
-    mover: WorldPolygon,
-    obstacle: WorldPolygon,
+    /// Continuous collision: the moving body's outline where its step ends and starts,
+    /// and the time-of-impact search's own.
+    mover_at_end: WorldPolygon,
+    mover_at_start: WorldPolygon,
     toi_scratch: WorldPolygon,
     /// Static bodies' outlines and bounds, for continuous collision.
     obstacles: Vec<(WorldPolygon, Aabb)>,
@@ -563,8 +565,8 @@ impl World {
             }
             .grown(radius + slop);
             let local = body.local_vertices();
-            place(&mut s.mover, local, sweep.end);
-            place(&mut s.toi_scratch, local, sweep.start);
+            place(&mut s.mover_at_end, local, sweep.end);
+            place(&mut s.mover_at_start, local, sweep.start);
             let mut first: Option<f64> = None;
             for (polygon, bounds) in &obstacles[..count] {
                 if !swept.overlaps(bounds) {
@@ -572,19 +574,18 @@ impl World {
                 }
                 // Ending in contact (within the solver's slop either way) is the contact
                 // solver's business: a landing, a body sliding along a floor.
-                let end_gap = separation(&s.mover, polygon);
+                let end_gap = separation(&s.mover_at_end, polygon);
                 if (-2.0 * slop..=slop).contains(&end_gap) {
                     continue;
                 }
                 // Apart at both ends, and too far apart for the motion to have touched in
                 // between (the gap shrinks no faster than `motion` per step).
                 if end_gap > slop {
-                    let start_gap = separation(&s.toi_scratch, polygon);
+                    let start_gap = separation(&s.mover_at_start, polygon);
                     if start_gap + end_gap > motion + 2.0 * slop {
                         continue;
                     }
                 }
-                let mut scratch = std::mem::take(&mut s.obstacle);
                 let hit = time_of_impact(
                     local,
                     radius,
@@ -592,9 +593,8 @@ impl World {
                     polygon,
                     slop,
                     0.25 * slop,
-                    &mut scratch,
+                    &mut s.toi_scratch,
                 );
-                s.obstacle = scratch;
                 if let Some(t) = hit {
                     first = Some(first.map_or(t, |f: f64| f.min(t)));
                 }
@@ -1215,22 +1215,11 @@ impl World {
                 (b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius()) * dt
             });
             s.reach.push(reach);
-            s.poses.push(body.as_ref().map_or(
-                Pose {
-                    position: Vec2::zeros(),
-                    rotation: Rot::default(),
-                    angle: 0.0,
-                    radius: 0.0,
-                },
-                |b| Pose {
-                    position: b.position,
-                    rotation: b.rotation(),
-                    angle: b.angle,
-                    radius: b.bounding_radius(),
-                },
-            ));
+            let pose = body.as_ref().map_or(Pose::default(), Pose::of);
+            s.poses.push(pose);
             s.boxes.push(body.as_ref().map(|b| {
-                polygon.update(b);
+                // The outline from the pose (one rotation per body, shared with reuse).
+                polygon.set_vertices(b.local_vertices().iter().map(|&v| pose.to_world(v)));
                 polygon.aabb().grown(0.5 * margin + reach)
             }));
         }

@@ -10,12 +10,12 @@
 //! more than the tolerance, which is kept far below the contact slop.
 
 use super::{ContactPoint, FeatureId, Manifold};
-use crate::body::BodyHandle;
+use crate::body::{Body, BodyHandle};
 use crate::math::{Rot, Vec2};
 
 /// Where a body is for the narrow phase: centroid, rotation, and the radius of the circle
 /// about the centroid that holds it.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Pose {
     pub position: Vec2,
     pub rotation: Rot,
@@ -24,7 +24,17 @@ pub struct Pose {
 }
 
 impl Pose {
-    fn to_world(self, local: Vec2) -> Vec2 {
+    pub fn of(body: &Body) -> Self {
+        Self {
+            position: body.position,
+            rotation: body.rotation(),
+            angle: body.angle,
+            radius: body.bounding_radius(),
+        }
+    }
+
+    /// A point given in the body's frame (about its centroid), in world coordinates.
+    pub fn to_world(self, local: Vec2) -> Vec2 {
         self.position + self.rotation.apply(local)
     }
 
