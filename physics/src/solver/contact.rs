@@ -4,6 +4,44 @@ use super::SolverBody;
 use crate::collide::FeatureId;
 use crate::math::{Vec2, cross, perp};
 
+/// The last solve's contact impulses by (body A, body B, feature), for warm starting the
+/// next: kept in contact order, which is by body pair as the broad phase lists pairs.
+#[derive(Debug, Clone, Default)]
+pub struct ContactMemory {
+    entries: Vec<((u32, u32, u32), f64, f64)>,
+}
+
+impl ContactMemory {
+    /// Keeps the impulses the solve wrote into `contacts`.
+    pub fn store(&mut self, contacts: &[Contact]) {
+        self.entries.clear();
+        self.entries.extend(contacts.iter().map(|c| {
+            let key = (c.body_a, c.body_b, c.id.0);
+            (key, c.normal_impulse, c.tangent_impulse)
+        }));
+    }
+
+    /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
+    /// the order of `contacts`. Both lists come by body pair in increasing order, so one
+    /// walk through the memory finds each pair's entries.
+    pub fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {
+        out.clear();
+        let mut cursor = 0;
+        let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
+        for c in contacts {
+            let pair = (c.body_a, c.body_b);
+            while self.entries.get(cursor).is_some_and(|m| pair_of(m) < pair) {
+                cursor += 1;
+            }
+            let found = self.entries[cursor..]
+                .iter()
+                .take_while(|m| pair_of(m) == pair)
+                .find(|m| m.0.2 == c.id.0);
+            out.push(found.map_or((0.0, 0.0), |m| (m.1, m.2)));
+        }
+    }
+}
+
 /// One contact point between bodies `a` and `b`, with its material and its last impulses.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {

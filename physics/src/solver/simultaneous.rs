@@ -3,7 +3,7 @@
 //! one boxed LCP whose friction bounds follow the normal impulses.
 
 use super::SolverBody;
-use super::contact::Contact;
+use super::contact::{Contact, ContactMemory};
 use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use super::lcp::{LcpProblem, LcpSolver, LcpStats};
@@ -69,11 +69,11 @@ pub struct SimultaneousSolver {
     pseudo: Vec<SolverBody>,
     /// Velocities of an island's bodies during the row-by-row Gauss–Seidel.
     sparse_bodies: Vec<SolverBody>,
-    /// Last solve's contact impulses by (body A, body B, feature), sorted: the row-by-row
-    /// Gauss–Seidel starts from them (warm start) instead of from zero.
-    memory: Vec<((u32, u32, u32), f64, f64)>,
-    /// Each contact's key into `memory`, by its index in this solve's contacts.
-    keys: Vec<(u32, u32, u32)>,
+    /// Last solve's contact impulses: the row-by-row Gauss–Seidel starts from them (warm
+    /// start) instead of from zero.
+    memory: ContactMemory,
+    /// Each of this solve's contacts' last (normal, tangent) impulses, by its index.
+    recalled: Vec<(f64, f64)>,
     /// The starting impulses of the rows being solved (empty: start from zero).
     guess: Vec<f64>,
     /// Each row's `A_ii`, for the row-by-row Gauss–Seidel.
@@ -108,9 +108,7 @@ impl SimultaneousSolver {
         targets: &VelocityTargets,
     ) {
         self.reports.clear();
-        self.keys.clear();
-        self.keys
-            .extend(contacts.iter().map(|c| (c.body_a, c.body_b, c.id.0)));
+        self.memory.recall(contacts, &mut self.recalled);
         self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
         for island in 0..self.ranges.len() {
             self.load_island(island, contacts, joints);
@@ -120,30 +118,16 @@ impl SimultaneousSolver {
             }
             self.write_back(contacts, joints);
         }
-        self.memory.clear();
-        self.memory.extend(
-            contacts
-                .iter()
-                .zip(&self.keys)
-                .map(|(c, &k)| (k, c.normal_impulse, c.tangent_impulse)),
-        );
-        self.memory.sort_unstable_by_key(|m| m.0);
+        self.memory.store(contacts);
     }
 
     /// Starting impulses for the rows from the last solve's, for contacts that persist.
     fn remember(&mut self) {
         self.guess.clear();
         for row in &self.rows {
-            let recalled = |i: u32| {
-                let key = self.keys[i as usize];
-                self.memory
-                    .binary_search_by(|m| m.0.cmp(&key))
-                    .ok()
-                    .map(|k| self.memory[k])
-            };
             self.guess.push(match row.kind {
-                RowKind::ContactNormal(i) => recalled(i).map_or(0.0, |m| m.1),
-                RowKind::ContactTangent(i) => recalled(i).map_or(0.0, |m| m.2),
+                RowKind::ContactNormal(i) => self.recalled[i as usize].0,
+                RowKind::ContactTangent(i) => self.recalled[i as usize].1,
                 _ => 0.0,
             });
         }

@@ -8,7 +8,7 @@
 //! through the substeps by their anchors.
 
 use super::SolverBody;
-use super::contact::Contact;
+use super::contact::{Contact, ContactMemory};
 use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
@@ -169,14 +169,6 @@ struct SoftJoint {
     input: u32,
 }
 
-/// One manifold of the point-by-point passes: `points[start]`, with `points[start + 1]`
-/// too when the two are solved as a 2 × 2 block.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-struct Run {
-    start: u32,
-    pair: bool,
-}
-
 /// Warm-start memory and buffers, kept between steps.
 #[derive(Debug, Clone, Default)]
 pub struct SoftStepSolver {
@@ -184,12 +176,9 @@ pub struct SoftStepSolver {
     points: Vec<PointConstraint>,
     joints: Vec<SoftJoint>,
     spare_joints: Vec<SoftJoint>,
-    /// The manifolds solved point by point (a lone point or a 2 × 2 pair).
-    runs: Vec<Run>,
-    /// Last step's impulses by (body A, body B, feature), in the order of its contacts:
-    /// by body pair, as the broad phase lists pairs.
-    memory: Vec<((u32, u32, u32), f64, f64)>,
-    next_memory: Vec<((u32, u32, u32), f64, f64)>,
+    /// Last step's contact impulses, and this step's contacts' share of them.
+    memory: ContactMemory,
+    recalled: Vec<(f64, f64)>,
     joint_memory: Vec<(u32, Vec2, f64)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
     joint_islands: Vec<(usize, usize)>,
@@ -279,29 +268,23 @@ impl SoftStepSolver {
             dangle: 0.0,
         }));
         self.points.clear();
-        // Contacts come by body pair in increasing order, as last step's did: one walk
-        // through the memory finds each pair's entries.
-        let mut cursor = 0;
+        self.memory.recall(contacts, &mut self.recalled);
         for (i, c) in contacts.iter().enumerate() {
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
             let r_a = c.point - a.position;
             let r_b = c.point - b.position;
             let t = perp(c.normal);
-            let k = |d: Vec2| {
-                let (ca, cb) = (cross(r_a, d), cross(r_b, d));
-                a.inv_mass + b.inv_mass + a.inv_inertia * ca * ca + b.inv_inertia * cb * cb
+            let levers = PointLevers {
+                normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
+                tangent: (cross(r_a, t), cross(r_b, t)),
+                reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
             };
-            let inverse = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
-            let pair = (c.body_a, c.body_b);
-            let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
-            while self.memory.get(cursor).is_some_and(|m| pair_of(m) < pair) {
-                cursor += 1;
-            }
-            let (normal_impulse, tangent_impulse) = self.memory[cursor..]
-                .iter()
-                .take_while(|m| pair_of(m) == pair)
-                .find(|m| m.0.2 == c.id.0)
-                .map_or((0.0, 0.0), |m| (m.1, m.2));
+            // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
+            let mass = |(la, lb): (f64, f64)| {
+                let k = a.inv_mass + b.inv_mass + a.inv_inertia * la * la + b.inv_inertia * lb * lb;
+                if k > 0.0 { 1.0 / k } else { 0.0 }
+            };
+            let (normal_impulse, tangent_impulse) = self.recalled[i];
             self.points.push(PointConstraint {
                 contact: i as u32,
                 a: c.body_a,
@@ -309,14 +292,10 @@ impl SoftStepSolver {
                 r_a,
                 r_b,
                 normal: c.normal,
-                levers: PointLevers {
-                    normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-                    tangent: (cross(r_a, t), cross(r_b, t)),
-                    reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
-                },
+                levers,
                 base_separation: -c.depth,
-                normal_mass: inverse(k(c.normal)),
-                tangent_mass: inverse(k(t)),
+                normal_mass: mass(levers.normal),
+                tangent_mass: mass(levers.tangent),
                 friction: c.friction,
                 restitution: c.restitution,
                 relative_velocity: c.approach_velocity,
@@ -339,9 +318,7 @@ impl SoftStepSolver {
                 continue;
             }
             let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-            let n = p.normal;
-            let (a1, a2) = (cross(p.r_a, n), cross(q.r_a, n));
-            let (b1, b2) = (cross(p.r_b, n), cross(q.r_b, n));
+            let ((a1, b1), (a2, b2)) = (p.levers.normal, q.levers.normal);
             let k12 = a.inv_mass + b.inv_mass + a.inv_inertia * a1 * a2 + b.inv_inertia * b1 * b2;
             let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
             let det = k11 * k22 - k12 * k12;
@@ -354,7 +331,6 @@ impl SoftStepSolver {
                 });
             }
         }
-        self.list_runs();
         self.joints.clear();
         for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
@@ -392,30 +368,6 @@ impl SoftStepSolver {
             });
         }
         self.group_joints();
-    }
-
-    /// Lists the manifolds outside the small LCP islands, in the points' order.
-    ///
-    /// That order (by island, then by body pair) is kept on purpose. Ordering by colours of
-    /// the constraint graph, as Box2D v3 does to solve a colour's manifolds side by side,
-    /// made the 100-row pyramid fall (421 of 5,050 boxes moved over half a box in 500
-    /// steps, against none): within one colour no two manifolds share a body, so a
-    /// Gauss–Seidel pass carries the load only as many layers as there are colours, while
-    /// the pair order, bottom row first, carries it through the whole pile.
-    fn list_runs(&mut self) {
-        self.runs.clear();
-        let mut i = 0;
-        while i < self.points.len() {
-            let p = &self.points[i];
-            let pair = p.pair_coupling.is_some();
-            if !p.in_lcp {
-                self.runs.push(Run {
-                    start: i as u32,
-                    pair,
-                });
-            }
-            i += if pair { 2 } else { 1 };
-        }
     }
 
     /// Records how each island of contacts and of pins was solved.
@@ -553,9 +505,17 @@ impl SoftStepSolver {
             max_push,
             use_bias,
         );
-        for run in &self.runs {
-            let i = run.start as usize;
-            if run.pair {
+        // In the points' order (by island, then by body pair) on purpose. Ordering by
+        // colours of the constraint graph, as Box2D v3 does to solve a colour's manifolds
+        // side by side, made the 100-row pyramid fall (421 of 5,050 boxes moved over half a
+        // box in 500 steps, against none): within one colour no two manifolds share a body,
+        // so a Gauss–Seidel pass carries the load only as many layers as there are colours,
+        // while the pair order, bottom row first, carries it through the whole pile.
+        let mut i = 0;
+        while i < self.points.len() {
+            if self.points[i].in_lcp {
+                i += 1;
+            } else if self.points[i].pair_coupling.is_some() {
                 let (first, second) = self.points.split_at_mut(i + 1);
                 solve_pair(
                     &mut self.bodies,
@@ -565,6 +525,7 @@ impl SoftStepSolver {
                     max_push,
                     use_bias,
                 );
+                i += 2;
             } else {
                 solve_point(
                     &mut self.bodies,
@@ -574,6 +535,7 @@ impl SoftStepSolver {
                     max_push,
                     use_bias,
                 );
+                i += 1;
             }
         }
     }
@@ -633,17 +595,12 @@ impl SoftStepSolver {
             b.position += s.dp;
             b.angle += s.dangle;
         }
-        self.next_memory.clear();
-        self.next_memory
-            .resize(contacts.len(), ((u32::MAX, u32::MAX, 0), 0.0, 0.0));
         for p in &self.points {
             let c = &mut contacts[p.contact as usize];
             c.normal_impulse = p.normal_impulse;
             c.tangent_impulse = p.tangent_impulse;
-            self.next_memory[p.contact as usize] =
-                ((p.a, p.b, c.id.0), p.normal_impulse, p.tangent_impulse);
         }
-        std::mem::swap(&mut self.memory, &mut self.next_memory);
+        self.memory.store(contacts);
         self.joint_memory.clear();
         for j in &self.joints {
             self.joint_memory.push((j.slot, j.impulse, j.motor_impulse));
@@ -799,14 +756,25 @@ fn solve_point(
     max_push: f64,
     use_bias: bool,
 ) {
-    let (target, (mass_scale, impulse_scale), separation) =
-        normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+    let (target, softness, separation) = normal_target(bodies, p, inv_h, soft, max_push, use_bias);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
-    let vn = approach(&pair, p, separation);
-    let impulse = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
-    apply_normal(&mut pair, p, p.normal_impulse + impulse);
+    solve_normal(&mut pair, p, target, softness, separation);
     solve_friction(&mut pair, p);
     pair.store(bodies);
+}
+
+/// One point's normal row alone: soft towards `target` with the softness scales.
+#[inline(always)]
+fn solve_normal(
+    pair: &mut BodyPair,
+    p: &mut PointConstraint,
+    target: f64,
+    (mass_scale, impulse_scale): (f64, f64),
+    separation: f64,
+) {
+    let vn = approach(pair, p, separation);
+    let impulse = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
+    apply_normal(pair, p, p.normal_impulse + impulse);
 }
 
 #[inline(always)]
@@ -837,14 +805,8 @@ fn solve_pair(
         let (v1, v2) = (approach(&pair, p, dp), approach(&pair, q, dq));
         solve_normal_pair(&mut pair, (p, q), (v1, v2), (tp, tq), sp);
     } else {
-        for (x, target, (mass_scale, impulse_scale), separation) in
-            [(&mut *p, tp, sp, dp), (&mut *q, tq, sq, dq)]
-        {
-            let vn = approach(&pair, x, separation);
-            let impulse =
-                -x.normal_mass * mass_scale * (vn - target) - impulse_scale * x.normal_impulse;
-            apply_normal(&mut pair, x, x.normal_impulse + impulse);
-        }
+        solve_normal(&mut pair, p, tp, sp, dp);
+        solve_normal(&mut pair, q, tq, sq, dq);
     }
     solve_friction(&mut pair, p);
     solve_friction(&mut pair, q);
@@ -1129,11 +1091,8 @@ struct ContactLcp {
 
 /// A point's two rows: direction, and lever arms on A and B.
 fn rows(p: &PointConstraint) -> [(Vec2, f64, f64); 2] {
-    let t = perp(p.normal);
-    [
-        (p.normal, cross(p.r_a, p.normal), cross(p.r_b, p.normal)),
-        (t, cross(p.r_a, t), cross(p.r_b, t)),
-    ]
+    let (n, t) = (p.levers.normal, p.levers.tangent);
+    [(p.normal, n.0, n.1), (perp(p.normal), t.0, t.1)]
 }
 
 impl ContactLcp {
