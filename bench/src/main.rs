@@ -1,7 +1,8 @@
-//! Times `pe` (contact solvers `exact` and `soft`) against rapier2d and Box2D v3 on scenes
-//! with known answers, and writes the results as Markdown to docs/bench/results.md.
+//! Times `pe` (contact solvers `exact`, `soft` and `auto`) against rapier2d and Box2D v3 on
+//! scenes with known answers, and writes the results as Markdown to docs/bench/results.md;
+//! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots.
 //!
-//! Run with `cargo run --release` inside bench/.
+//! Run with `cargo run --release [-- sweep]` inside bench/.
 
 mod box2d_scenes;
 mod harness;
@@ -73,10 +74,12 @@ fn run_row(
     eprint!(" Box2D…");
     let box2d = box2d_run();
     eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
-    for o in &pe {
+    let names = PE_SOLVERS.iter().map(|s| format!("pe {}", s.name()));
+    let all = pe.iter().chain([&rapier, &box2d]);
+    for (name, o) in names.chain(PEERS.map(String::from)).zip(all) {
         if o.timing.cut_short() {
             eprintln!(
-                "  (a pe run stopped after {} steps: budget)",
+                "  ({name} stopped after {} steps: budget)",
                 o.timing.steps_run
             );
         }
@@ -91,28 +94,20 @@ fn run_row(
 
 fn main() {
     let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench");
+    let load = load_average();
+    let started = Instant::now();
     if std::env::args().nth(1).as_deref() == Some("sweep") {
-        let started = Instant::now();
         let mut md = sweep::run(docs);
         let _ = writeln!(
             md,
-            "Machine: {}; load average at start: {}; {}; whole sweep {:.0} s.",
+            "Machine: {}; load average at start: {load}; {}; whole sweep {:.0} s.",
             machine(),
-            load_average(),
             today(),
             started.elapsed().as_secs_f64()
         );
-        let path = format!("{docs}/sweep.md");
-        if let Err(e) = std::fs::write(&path, &md) {
-            eprintln!("could not write {path}: {e}");
-            std::process::exit(1);
-        }
-        println!("{md}");
-        eprintln!("written to docs/bench/sweep.md");
+        write_doc(docs, "sweep.md", &md);
         return;
     }
-    let load = load_average();
-    let started = Instant::now();
     let mut rows = Vec::new();
     for spec in &PYRAMIDS {
         rows.push(run_row(
@@ -162,13 +157,18 @@ fn main() {
     ));
     let narrow = narrow_phase_rows(&rows);
     let report = report(&rows, &narrow, started.elapsed(), &load);
-    println!("{report}");
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench/results.md");
-    if let Err(e) = std::fs::write(path, &report) {
+    write_doc(docs, "results.md", &report);
+}
+
+/// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
+fn write_doc(docs: &str, file: &str, md: &str) {
+    println!("{md}");
+    let path = format!("{docs}/{file}");
+    if let Err(e) = std::fs::write(&path, md) {
         eprintln!("could not write {path}: {e}");
         std::process::exit(1);
     }
-    eprintln!("written to docs/bench/results.md");
+    eprintln!("written to docs/bench/{file}");
 }
 
 /// pe soft with the narrow phase's manifold reuse on (the row's own run) and off, on the

@@ -8,8 +8,8 @@ use crate::scene::{
     PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
 };
 use pe::{
-    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle, Vec2,
-    World,
+    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle,
+    StepSettings, Vec2, World,
 };
 
 /// How pe is set up for a run: the contact solver, the integrator, the soft step's
@@ -25,11 +25,12 @@ pub struct PeConfig {
 impl PeConfig {
     /// The solver with pe's defaults for the rest.
     pub fn new(solver: ContactSolver) -> Self {
+        let defaults = StepSettings::default();
         Self {
             solver,
-            integrator: Integrator::default(),
-            soft_substeps: 4,
-            reuse_manifolds: true,
+            integrator: defaults.integrator,
+            soft_substeps: defaults.soft_substeps,
+            reuse_manifolds: defaults.reuse_manifolds,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! The scenes, independent of any engine: sizes and placements in metres with y pointing
 //! UP (each engine module mirrors them into its own convention), their known answers, and
 //! the trackers that turn a run into the scene's metric. Keeping the trackers here means
-//! both engines are judged by the same code.
+//! every engine is judged by the same code.
 
 use std::f64::consts::PI;
 use std::fmt;
@@ -11,12 +11,12 @@ pub const G: f64 = 10.0;
 /// The default step, s.
 pub const H: f64 = 1.0 / 60.0;
 
-/// Friction coefficient of every contact in the pyramids (the floor's too, so that both
-/// engines' combination rules give 0.6).
+/// Friction coefficient of every contact (the floor's too, so that every engine's
+/// combination rule gives 0.6).
 pub const FRICTION: f64 = 0.6;
 /// Side of a pyramid box, m.
 pub const BOX: f64 = 1.0;
-/// Size of the static floor, m; its top face is the line y = 0.
+/// Size of the static floor, m (its top face at y = 0, or at each `Pyramid::floor_tops`).
 pub const FLOOR: (f64, f64) = (200.0, 1.0);
 
 /// The larger of a running worst value and a new sample, where a NaN sample (an engine

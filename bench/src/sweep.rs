@@ -8,7 +8,7 @@
 
 use crate::harness::Timing;
 use crate::pe_scenes::{self, PeConfig};
-use crate::scene::{Metric, Pendulum, Pyramid, STACKS, chain};
+use crate::scene::{H, Metric, Pendulum, Pyramid, STACKS, chain};
 use crate::{Outcome, box2d_scenes, rapier_scenes};
 use pe::{ContactSolver, Integrator};
 use plotters::prelude::*;
@@ -32,7 +32,6 @@ enum Engine {
 fn configurations() -> Vec<(String, Engine)> {
     let pe = |solver, integrator, soft_substeps| {
         Engine::Pe(PeConfig {
-            solver,
             integrator,
             soft_substeps,
             ..PeConfig::new(solver)
@@ -81,10 +80,10 @@ struct Scene {
     error: fn(&Metric) -> f64,
 }
 
-/// A stack at step `h` for 10 s.
+/// A stack at step `h`, for as long as `spec.steps` last at `H`.
 fn stack(spec: &Pyramid, engine: Engine, h: f64) -> Outcome {
     let spec = Pyramid {
-        steps: (10.0 / h).round() as usize,
+        steps: (spec.steps as f64 * H / h).round() as usize,
         ..*spec
     };
     match engine {
@@ -193,7 +192,8 @@ pub fn run(out_dir: &str) -> String {
          `sweep-<scene>.svg`, are log–log: error against compute time per simulated second \
          (time per step ÷ h), since a finer step costs more steps for the same motion; \
          errors below {ERROR_FLOOR:e} are drawn at it. A run that went non-finite shows \
-         NaN.\n"
+         NaN; one that the wall-time budget cut short is marked † and left off the plot \
+         (its error covers only the steps run).\n"
     );
     for scene in scenes() {
         eprint!("{}:", scene.name);
@@ -225,9 +225,10 @@ pub fn run(out_dir: &str) -> String {
         for (label, points) in &series {
             let _ = write!(md, "| {label} |");
             for p in points {
+                let cut = if p.timing.cut_short() { " †" } else { "" };
                 let _ = write!(
                     md,
-                    " {:.2e} in {} |",
+                    " {:.2e} in {}{cut} |",
                     p.error,
                     crate::pretty(p.timing.median)
                 );
@@ -255,7 +256,7 @@ fn plot(
     let finite: Vec<(f64, f64)> = series
         .iter()
         .flat_map(|(_, points)| points)
-        .filter(|p| p.error.is_finite())
+        .filter(|p| p.error.is_finite() && !p.timing.cut_short())
         .map(|p| (p.work(), p.error.max(ERROR_FLOOR)))
         .collect();
     let (t_min, t_max) = finite
@@ -295,7 +296,7 @@ fn plot(
         let color = Palette99::pick(k).to_rgba();
         let xy: Vec<(f64, f64)> = points
             .iter()
-            .filter(|p| p.error.is_finite())
+            .filter(|p| p.error.is_finite() && !p.timing.cut_short())
             .map(|p| (p.work(), p.error.max(ERROR_FLOOR)))
             .collect();
         chart
