@@ -211,16 +211,10 @@ fuzz_target!(|spec: Spec| {
         let _ = world.add_joint(def);
     }
 
-    if spec.median_scale {
-        let mut sizes: Vec<f64> = world
-            .bodies()
-            .filter(|(_, b)| !b.is_static())
-            .map(|(_, b)| b.bounding_radius())
-            .collect();
-        sizes.sort_by(f64::total_cmp);
-        if let Some(&median) = sizes.get(sizes.len() / 2) {
-            world.settings.length_scale = median;
-        }
+    if spec.median_scale
+        && let Some(size) = world.median_body_radius()
+    {
+        world.settings.length_scale = size;
     }
 
     assert_finite(&world, 0);

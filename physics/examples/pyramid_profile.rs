@@ -6,11 +6,11 @@ use std::time::Instant;
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let solver = match args.next().as_deref() {
-        Some("exact") => ContactSolver::Exact,
-        Some("thesis") => ContactSolver::Thesis,
-        Some("auto") => ContactSolver::Auto,
-        _ => ContactSolver::Soft,
+    let name = args.next().unwrap_or_else(|| "soft".into());
+    let Some(solver) = ContactSolver::from_name(&name) else {
+        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
+        eprintln!("unknown solver {name:?}: one of {}", names.join(", "));
+        std::process::exit(2);
     };
     let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
     let rows: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);

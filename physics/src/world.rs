@@ -276,6 +276,18 @@ impl World {
     }
 
     /// Live bodies in handle order.
+    /// The median bounding radius of the bodies that can move (none: `None`): the size of
+    /// a typical body, for `StepSettings::length_scale` in a scene not in metres.
+    pub fn median_body_radius(&self) -> Option<f64> {
+        let mut sizes: Vec<f64> = self
+            .bodies()
+            .filter(|(_, b)| !b.is_static())
+            .map(|(_, b)| b.bounding_radius())
+            .collect();
+        sizes.sort_by(f64::total_cmp);
+        sizes.get(sizes.len() / 2).copied()
+    }
+
     pub fn bodies(&self) -> impl Iterator<Item = (BodyHandle, &Body)> {
         self.bodies
             .iter()

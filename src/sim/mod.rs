@@ -311,7 +311,9 @@ impl Simulation {
             let at = (Vec2::new(p.x, p.y), p.orientation);
             self.add_body(p.alias.clone(), PlacedBy::SceneBody(k), p, at)?;
         }
-        self.world.settings.length_scale = length_scale(&self.world);
+        // Scenes are in pixels, tens of units per body, not metres: tolerances scale with
+        // the typical body.
+        self.world.settings.length_scale = self.world.median_body_radius().unwrap_or(1.0);
         Ok(())
     }
 
@@ -408,19 +410,4 @@ impl Simulation {
                 && b.angular_velocity.is_finite())
         })
     }
-}
-
-/// The world's length scale for tolerances: the median size (bounding radius) of the
-/// dynamic bodies — scenes are in pixels, tens of units per body, not metres.
-fn length_scale(world: &World) -> f64 {
-    let mut sizes: Vec<f64> = world
-        .bodies()
-        .filter(|(_, b)| !b.is_static())
-        .map(|(_, b)| b.bounding_radius())
-        .collect();
-    if sizes.is_empty() {
-        return 1.0;
-    }
-    sizes.sort_by(f64::total_cmp);
-    sizes[sizes.len() / 2]
 }
