@@ -118,7 +118,7 @@ impl Robot {
     pub fn body(&self, alias: &str) -> Option<&RobotBody> {
         self.bodies
             .iter()
-            .find(|b| b.placement.alias.trim() == alias.trim())
+            .find(|b| same_name(&b.placement.alias, alias))
     }
 }
 
@@ -167,19 +167,29 @@ pub struct Model {
     pub scenes: Vec<Scene>,
 }
 
+/// Whether two names (or a name and a reference to it) are the same: whitespace around
+/// either is ignored (the thesis's own example says `source=" housenka"`; a name written
+/// `name=" box "` could otherwise never be referred to). Every lookup, rename and delete
+/// matches names by this rule.
+pub fn same_name(a: &str, b: &str) -> bool {
+    a.trim() == b.trim()
+}
+
 impl Model {
-    /// Looks a body definition up by name; whitespace around `name`, and around the stored
-    /// name, is ignored (the thesis's own example says `source=" housenka"`; a name written
-    /// `name=" box "` could otherwise never be referred to).
+    /// Looks a body definition up by name (see `same_name`).
     pub fn body(&self, name: &str) -> Option<&BodyDef> {
-        self.bodies.iter().find(|b| b.name.trim() == name.trim())
+        self.bodies.iter().find(|b| same_name(&b.name, name))
     }
 
     pub fn robot(&self, name: &str) -> Option<&Robot> {
-        self.robots.iter().find(|r| r.name.trim() == name.trim())
+        self.robots.iter().find(|r| same_name(&r.name, name))
+    }
+
+    pub fn robot_mut(&mut self, name: &str) -> Option<&mut Robot> {
+        self.robots.iter_mut().find(|r| same_name(&r.name, name))
     }
 
     pub fn scene(&self, name: &str) -> Option<&Scene> {
-        self.scenes.iter().find(|s| s.name.trim() == name.trim())
+        self.scenes.iter().find(|s| same_name(&s.name, name))
     }
 }

@@ -744,3 +744,40 @@ fn names_with_surrounding_spaces_can_be_referred_to() {
     model.robots[0].bodies[0].placement.alias = format!(" {alias} ");
     assert!(model.robots[0].body(&alias).is_some());
 }
+
+#[test]
+fn rename_and_delete_follow_names_with_surrounding_spaces() {
+    // Lookups ignored the spaces around a stored name while rename and delete compared
+    // references with the stored name as written: renaming " x " left its references
+    // dangling, and a cascade delete left its placements behind.
+    let (db, _) = Database::embedded();
+    let mut model = db.model;
+    let body = model.robots[0].bodies[0]
+        .placement
+        .source
+        .trim()
+        .to_string();
+    let index = model.bodies.iter().position(|b| b.name == body).unwrap();
+    let stored = format!(" {body} ");
+    model.bodies[index].name = stored.clone();
+    let uses = |m: &Model, name: &str| {
+        m.robots
+            .iter()
+            .flat_map(|r| &r.bodies)
+            .filter(|b| b.placement.source.trim() == name)
+            .count()
+            + m.scenes
+                .iter()
+                .flat_map(|s| &s.bodies)
+                .filter(|b| b.source.trim() == name)
+                .count()
+    };
+    let before = uses(&model, &body);
+    assert!(before > 0);
+    model.rename_body(&stored, "renamed").unwrap();
+    assert_eq!(uses(&model, "renamed"), before);
+    assert_eq!(uses(&model, &body), 0);
+    model.bodies[index].name = " renamed ".into();
+    model.delete_body(" renamed ", Delete::Cascade).unwrap();
+    assert_eq!(uses(&model, "renamed"), 0);
+}

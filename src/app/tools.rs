@@ -137,11 +137,7 @@ pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDe
         anchor_ay: p.y - origin.1,
         ..JointDef::default()
     };
-    let robot = model
-        .robots
-        .iter_mut()
-        .find(|r| r.name.trim() == robot_name.trim())
-        .expect("found above");
+    let robot = model.robot_mut(robot_name).expect("found above");
     robot.joints.push(joint.clone());
     Ok(joint)
 }

@@ -338,8 +338,8 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             clip(solver)
         ));
     }
+    let what = format!("<robot> in scene \"{}\"", clip(&scene.name));
     for r in &scene.robots {
-        let what = format!("<robot> in scene \"{}\"", clip(&scene.name));
         for message in beyond_all(&[
             ("x", r.x, limits::COORDINATE),
             ("y", r.y, limits::COORDINATE),
@@ -351,7 +351,7 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             out.push(
                 Problem::error(
                     file,
-                    &format!("<robot> in scene \"{}\"", clip(&scene.name)),
+                    &what,
                     format!(
                         "source \"{}\" is not a robot in robots.xml",
                         clip(&r.source)

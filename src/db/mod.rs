@@ -12,7 +12,7 @@ pub use check::{TIMESTEP_RANGE, beyond_all, check, limits, outline_polygon, poly
 pub use problem::{Problem, Severity};
 pub use xml::{MAX_DEPTH, clip};
 
-use crate::model::Model;
+use crate::model::{Model, same_name};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -387,13 +387,17 @@ impl Model {
         let mut users: Vec<User> = self
             .robots
             .iter()
-            .filter(|r| r.bodies.iter().any(|b| b.placement.source.trim() == name))
+            .filter(|r| {
+                r.bodies
+                    .iter()
+                    .any(|b| same_name(&b.placement.source, name))
+            })
             .map(|r| User::Robot(r.name.clone()))
             .collect();
         users.extend(
             self.scenes
                 .iter()
-                .filter(|s| s.bodies.iter().any(|b| b.source.trim() == name))
+                .filter(|s| s.bodies.iter().any(|b| same_name(&b.source, name)))
                 .map(|s| User::Scene(s.name.clone())),
         );
         users
@@ -404,7 +408,7 @@ impl Model {
         let name = name.trim();
         self.scenes
             .iter()
-            .filter(|s| s.robots.iter().any(|r| r.source.trim() == name))
+            .filter(|s| s.robots.iter().any(|r| same_name(&r.source, name)))
             .map(|s| User::Scene(s.name.clone()))
             .collect()
     }
@@ -424,9 +428,12 @@ impl Model {
         let index = self
             .bodies
             .iter()
-            .position(|b| b.name == old)
+            .position(|b| same_name(&b.name, old))
             .ok_or_else(|| EditError::Missing(old.into()))?;
-        Self::check_new_name(self.body(new).is_some_and(|b| b.name != old), new)?;
+        Self::check_new_name(
+            self.body(new).is_some_and(|b| !same_name(&b.name, old)),
+            new,
+        )?;
         self.bodies[index].name = new.to_string();
         for p in self
             .robots
@@ -434,12 +441,12 @@ impl Model {
             .flat_map(|r| r.bodies.iter_mut())
             .map(|b| &mut b.placement)
         {
-            if p.source.trim() == old {
+            if same_name(&p.source, old) {
                 p.source = new.to_string();
             }
         }
         for p in self.scenes.iter_mut().flat_map(|s| s.bodies.iter_mut()) {
-            if p.source.trim() == old {
+            if same_name(&p.source, old) {
                 p.source = new.to_string();
             }
         }
@@ -451,12 +458,15 @@ impl Model {
         let index = self
             .robots
             .iter()
-            .position(|r| r.name == old)
+            .position(|r| same_name(&r.name, old))
             .ok_or_else(|| EditError::Missing(old.into()))?;
-        Self::check_new_name(self.robot(new).is_some_and(|r| r.name != old), new)?;
+        Self::check_new_name(
+            self.robot(new).is_some_and(|r| !same_name(&r.name, old)),
+            new,
+        )?;
         self.robots[index].name = new.to_string();
         for r in self.scenes.iter_mut().flat_map(|s| s.robots.iter_mut()) {
-            if r.source.trim() == old {
+            if same_name(&r.source, old) {
                 r.source = new.to_string();
             }
         }
@@ -467,9 +477,12 @@ impl Model {
         let index = self
             .scenes
             .iter()
-            .position(|s| s.name == old)
+            .position(|s| same_name(&s.name, old))
             .ok_or_else(|| EditError::Missing(old.into()))?;
-        Self::check_new_name(self.scene(new).is_some_and(|s| s.name != old), new)?;
+        Self::check_new_name(
+            self.scene(new).is_some_and(|s| !same_name(&s.name, old)),
+            new,
+        )?;
         self.scenes[index].name = new.to_string();
         Ok(())
     }
@@ -480,7 +493,7 @@ impl Model {
         let index = self
             .bodies
             .iter()
-            .position(|b| b.name == name)
+            .position(|b| same_name(&b.name, name))
             .ok_or_else(|| EditError::Missing(name.into()))?;
         let users = self.body_users(name);
         if !users.is_empty() && mode == Delete::IfUnused {
@@ -494,16 +507,18 @@ impl Model {
             let removed: Vec<String> = robot
                 .bodies
                 .iter()
-                .filter(|b| b.placement.source.trim() == name)
+                .filter(|b| same_name(&b.placement.source, name))
                 .map(|b| b.placement.alias.clone())
                 .collect();
-            robot.bodies.retain(|b| b.placement.source.trim() != name);
+            robot
+                .bodies
+                .retain(|b| !same_name(&b.placement.source, name));
             robot
                 .joints
                 .retain(|j| !removed.contains(&j.body_a) && !removed.contains(&j.body_b));
         }
         for scene in &mut self.scenes {
-            scene.bodies.retain(|b| b.source.trim() != name);
+            scene.bodies.retain(|b| !same_name(&b.source, name));
         }
         Ok(())
     }
@@ -513,7 +528,7 @@ impl Model {
         let index = self
             .robots
             .iter()
-            .position(|r| r.name == name)
+            .position(|r| same_name(&r.name, name))
             .ok_or_else(|| EditError::Missing(name.into()))?;
         let users = self.robot_users(name);
         if !users.is_empty() && mode == Delete::IfUnused {
@@ -524,7 +539,7 @@ impl Model {
         }
         self.robots.remove(index);
         for scene in &mut self.scenes {
-            scene.robots.retain(|r| r.source.trim() != name);
+            scene.robots.retain(|r| !same_name(&r.source, name));
         }
         Ok(())
     }
@@ -533,7 +548,7 @@ impl Model {
         let index = self
             .scenes
             .iter()
-            .position(|s| s.name == name)
+            .position(|s| same_name(&s.name, name))
             .ok_or_else(|| EditError::Missing(name.into()))?;
         self.scenes.remove(index);
         Ok(())
