@@ -17,6 +17,16 @@ fn every_default_scene_simulates_1000_steps_without_nan() {
     let model = model();
     for scene in &model.scenes {
         let mut sim = Simulation::new(&model, &scene.name, None, None).unwrap();
+        // The widest any joint opens during the run. Pins under `exact` hold to a
+        // hundredth of a pixel (measured at worst 9.5e-4 px, housenka landing). Soft pins
+        // are springs (60 Hz): the car pushing the pyramid under `auto` opens 0.13 px at
+        // worst. (Continuous collision used to send the four-bar linkage's coupler back
+        // from the frame's pivot it passes over, opening its pins 2.1 px once a turn.)
+        let tolerance = match sim.world.settings.contact_solver {
+            ContactSolver::Soft | ContactSolver::Auto => 0.2,
+            _ => 0.01,
+        };
+        let mut widest: f64 = 0.0;
         for step in 0..1000 {
             sim.step();
             assert!(
@@ -24,19 +34,11 @@ fn every_default_scene_simulates_1000_steps_without_nan() {
                 "{}: non-finite at step {step}",
                 scene.name
             );
+            widest = widest.max(sim.metrics().max_joint_gap);
         }
-        // The gap after the run (not the worst during it: mid-run, the four-bar linkage
-        // opens 2.1 px and the double pendulum 1.0 px under `exact` before closing again,
-        // an open defect). Soft pins are springs (60 Hz): the car pushing the pyramid
-        // under `auto` ends 0.03 px open (0.13 px at worst, mid-run).
-        let tolerance = match sim.world.settings.contact_solver {
-            ContactSolver::Soft | ContactSolver::Auto => 0.05,
-            _ => 0.01,
-        };
-        let gap = sim.metrics().max_joint_gap;
         assert!(
-            gap < tolerance,
-            "{}: joints hold to {tolerance} px, worst {gap}",
+            widest < tolerance,
+            "{}: joints hold to {tolerance} px, widest {widest}",
             scene.name
         );
     }

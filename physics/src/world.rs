@@ -2,7 +2,7 @@
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
-use crate::collide::toi::{Sweep, place, separation, time_of_impact};
+use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
 use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
@@ -231,8 +231,12 @@ struct Scratch {
     mover_at_end: WorldPolygon,
     mover_at_start: WorldPolygon,
     toi_scratch: WorldPolygon,
-    /// Static bodies' outlines and bounds, for continuous collision.
-    obstacles: Vec<(WorldPolygon, Aabb)>,
+    /// Continuous collision: static bodies' slots, outlines and bounds; the bodies
+    /// stopped and their times of impact; joint islands and each island's earliest impact.
+    obstacles: Vec<(u32, WorldPolygon, Aabb)>,
+    impacts: Vec<(u32, f64)>,
+    impact_union: UnionFind,
+    island_impact: Vec<f64>,
     /// `auto`: the islands' links and row counts, which bodies are in big islands, the
     /// bodies held in the current pass, the exact pass's contacts while the soft pass
     /// runs, and both passes' island reports.
@@ -462,13 +466,15 @@ impl World {
     /// motor running, goes to sleep: it is skipped until an awake body comes within reach
     /// of one of its bodies, a motor on it switches on, or `wake_body` is called.
     ///
-    /// With `settings.continuous`, a body that moved more than half its inner radius (or
-    /// the contact margin) this step and ended up through a static body, or deeper than
-    /// twice the slop in it, is put back along its path to
-    /// where it first came within the slop of it (its time of impact), keeping its velocity
-    /// for the next step's contacts to answer. Speculative contacts stop most fast bodies
-    /// already; this catches what they miss (a spinning body, the soft step's contacts
-    /// found only at the step's start).
+    /// With `settings.continuous`, a body that moved more than half its inner radius (or,
+    /// without joints, the contact margin) this step and ended up through a static body
+    /// it collides with, or deeper than twice the slop in it, is put back along its path
+    /// to where it first came within the slop of it (its time of impact) or, if it
+    /// started in contact, to where it was twice the slop deep. It keeps its velocity for
+    /// the next step's contacts to answer. A jointed body takes its joint island with it,
+    /// each body to the same fraction of its path. Speculative contacts stop most fast
+    /// bodies already; this catches what they miss (a spinning body, the soft step's
+    /// contacts found only at the step's start, a link the thesis's joint pass drags on).
     ///
     /// A step that would put a non-finite number into the state (see `try_step`) does
     /// nothing.
@@ -530,10 +536,11 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
-        // The static bodies' outlines and bounds, built once per step when the first body
-        // needs them (most steps, none does).
+        // The static bodies' slots, outlines and bounds, built once per step when the
+        // first body needs them (most steps, none does).
         let mut obstacles = std::mem::take(&mut s.obstacles);
         let mut count: Option<usize> = None;
+        s.impacts.clear();
         for i in 0..self.bodies.len() {
             let Some(body) = self.bodies[i].as_ref() else {
                 continue;
@@ -549,22 +556,26 @@ impl World {
             let motion =
                 (sweep.end.0 - sweep.start.0).norm() + (sweep.end.1 - sweep.start.1).abs() * radius;
             // Fast bodies, and bodies an impact sent further than the contact margin (their
-            // contacts were found before the solve, for the motion they had then). Moving a
-            // jointed body back opens its pins, so jointed bodies only when fast enough to
-            // pass through something: a wheel rolling over terrain is the contacts' job.
+            // contacts were found before the solve, for the motion they had then). A
+            // jointed body only when fast enough to pass through something: its whole
+            // mechanism goes back with it (below), and a wheel pressed a little deep into
+            // terrain would hold the car back every step; that is the contacts' job.
             let fast = 0.5 * body.inner_radius();
             let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
             if motion <= if jointed { fast } else { fast.min(margin) } {
                 continue;
             }
             let count = *count.get_or_insert_with(|| {
-                let statics = self.bodies.iter().flatten().filter(|o| o.is_static());
                 let mut n = 0;
-                for obstacle in statics {
+                for (slot, obstacle) in self.bodies.iter().enumerate() {
+                    let Some(obstacle) = obstacle.as_ref().filter(|o| o.is_static()) else {
+                        continue;
+                    };
                     if obstacles.len() == n {
-                        obstacles.push((WorldPolygon::default(), Aabb::default()));
+                        obstacles.push((0, WorldPolygon::default(), Aabb::default()));
                     }
-                    let (polygon, bounds) = &mut obstacles[n];
+                    let (index, polygon, bounds) = &mut obstacles[n];
+                    *index = slot as u32;
                     polygon.update(obstacle);
                     *bounds = polygon.aabb();
                     n += 1;
@@ -580,8 +591,14 @@ impl World {
             place(&mut s.mover_at_end, local, sweep.end);
             place(&mut s.mover_at_start, local, sweep.start);
             let mut first: Option<f64> = None;
-            for (polygon, bounds) in &obstacles[..count] {
+            for (obstacle, polygon, bounds) in &obstacles[..count] {
                 if !swept.overlaps(bounds) {
+                    continue;
+                }
+                // A static body this one never collides with (a robot's pivot that its
+                // own links pass over) is no obstacle.
+                let pair = ((i as u32).min(*obstacle), (i as u32).max(*obstacle));
+                if self.non_colliding.binary_search(&pair).is_ok() {
                     continue;
                 }
                 // Ending in contact (within the solver's slop either way) is the contact
@@ -598,6 +615,9 @@ impl World {
                         continue;
                     }
                 }
+                // In contact at the start and far deeper at the end: the contact solver
+                // did not hold it (under `thesis`, the joint pass after the contacts drags
+                // a stopped link on into a wall); it goes back to where it was 2 × slop deep.
                 let hit = time_of_impact(
                     local,
                     radius,
@@ -606,19 +626,83 @@ impl World {
                     slop,
                     0.25 * slop,
                     &mut s.toi_scratch,
-                );
+                )
+                .or_else(|| {
+                    if end_gap >= -2.0 * slop {
+                        return None;
+                    }
+                    time_of_sinking(
+                        local,
+                        radius,
+                        &sweep,
+                        polygon,
+                        2.0 * slop,
+                        0.25 * slop,
+                        &mut s.toi_scratch,
+                    )
+                });
                 if let Some(t) = hit {
                     first = Some(first.map_or(t, |f: f64| f.min(t)));
                 }
             }
             if let Some(t) = first {
-                let (position, angle) = sweep.at(t);
-                let body = self.bodies[i].as_mut().expect("checked above");
-                body.position = position;
-                body.angle = angle;
+                s.impacts.push((i as u32, t));
             }
         }
         s.obstacles = obstacles;
+        self.move_back_to_impacts();
+    }
+
+    /// Moves each body that continuous collision stopped back along its sweep to its time
+    /// of impact. A jointed body takes its joint island with it, every moving body to the
+    /// same fraction of its own sweep: moving one link alone would open its pins by the
+    /// rest of the step's motion. (Turning bodies' pins then stay together to second order
+    /// in the step's rotation; the joint passes close the rest next step.)
+    fn move_back_to_impacts(&mut self) {
+        let s = &mut self.scratch;
+        if s.impacts.is_empty() {
+            return;
+        }
+        let bodies = &mut self.bodies;
+        let moving = |i: usize| bodies[i].as_ref().is_some_and(|b| !b.is_fixed());
+        let jointed_hit = s
+            .impacts
+            .iter()
+            .any(|(i, _)| self.jointed.binary_search(i).is_ok());
+        if jointed_hit {
+            s.impact_union.reset(bodies.len());
+            for j in self.joints.iter().flatten() {
+                if let Some(b) = j.body_b {
+                    let (ia, ib) = (j.body_a.index(), b.index());
+                    if moving(ia) && moving(ib) {
+                        s.impact_union.union(ia as u32, ib as u32);
+                    }
+                }
+            }
+            s.island_impact.clear();
+            s.island_impact.resize(bodies.len(), f64::INFINITY);
+            for &(i, t) in &s.impacts {
+                let root = s.impact_union.find(i) as usize;
+                s.island_impact[root] = s.island_impact[root].min(t);
+            }
+            s.impacts.clear();
+            for i in 0..bodies.len() {
+                if moving(i) {
+                    let t = s.island_impact[s.impact_union.find(i as u32) as usize];
+                    if t.is_finite() {
+                        s.impacts.push((i as u32, t));
+                    }
+                }
+            }
+        }
+        for &(i, t) in &s.impacts {
+            let body = bodies[i as usize].as_mut().expect("a moving body");
+            let sweep = Sweep {
+                start: s.step_start[i as usize],
+                end: (body.position, body.angle),
+            };
+            (body.position, body.angle) = sweep.at(t);
+        }
     }
 
     /// Wakes `handle` and everything asleep in its island.

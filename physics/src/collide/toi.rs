@@ -75,6 +75,40 @@ pub fn time_of_impact(
     Some(t)
 }
 
+/// For a polygon that starts the sweep in contact with `obstacle` (no deeper than `depth`)
+/// and ends deeper: the last t, found by bisection to within `tolerance` of motion, at
+/// which it is still no deeper than `depth`. This is where a contact solver that failed
+/// to hold it (a body dragged into a wall by something else) should have left it.
+/// `None` if it starts deeper than `depth`, or does not end deeper.
+pub fn time_of_sinking(
+    local: &[Vec2],
+    radius: f64,
+    sweep: &Sweep,
+    obstacle: &WorldPolygon,
+    depth: f64,
+    tolerance: f64,
+    scratch: &mut WorldPolygon,
+) -> Option<f64> {
+    let mut gap_at = |t: f64| {
+        place(scratch, local, sweep.at(t));
+        separation(scratch, obstacle)
+    };
+    if gap_at(0.0) < -depth || gap_at(1.0) >= -depth {
+        return None;
+    }
+    let speed = sweep.speed_bound(radius);
+    let (mut shallow, mut deep) = (0.0, 1.0);
+    while (deep - shallow) * speed > tolerance {
+        let t = 0.5 * (shallow + deep);
+        if gap_at(t) >= -depth {
+            shallow = t;
+        } else {
+            deep = t;
+        }
+    }
+    Some(shallow)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,5 +175,35 @@ mod tests {
             time_of_impact(&local, 0.75, &sliding, &wall, 0.005, 1e-6, &mut scratch),
             None
         );
+    }
+
+    #[test]
+    fn a_box_pushed_into_a_wall_from_contact_stops_at_the_allowed_depth() {
+        // The unit box touches the wall (right face at x = −0.01) and is pushed 0.3 into
+        // it: allowed 0.002 deep, it stops with its centre at −0.508.
+        let wall = square(Vec2::zeros(), 0.01);
+        let local = square(Vec2::zeros(), 0.5).vertices;
+        let sweep = Sweep {
+            start: (Vec2::new(-0.51, 0.0), 0.0),
+            end: (Vec2::new(-0.21, 0.0), 0.0),
+        };
+        let mut scratch = WorldPolygon::default();
+        let t = time_of_sinking(&local, 0.75, &sweep, &wall, 0.002, 1e-9, &mut scratch)
+            .expect("it sinks");
+        let x = sweep.at(t).0.x;
+        assert!((x - -0.508).abs() < 1e-9, "stopped at x = {x}");
+        // Deeper than allowed at the start, or not deeper at the end: not its business.
+        let from_deep = Sweep {
+            start: (Vec2::new(-0.4, 0.0), 0.0),
+            end: (Vec2::new(-0.3, 0.0), 0.0),
+        };
+        let leaving = Sweep {
+            start: (Vec2::new(-0.51, 0.0), 0.0),
+            end: (Vec2::new(-0.9, 0.0), 0.0),
+        };
+        for sweep in [from_deep, leaving] {
+            let t = time_of_sinking(&local, 0.75, &sweep, &wall, 0.002, 1e-9, &mut scratch);
+            assert_eq!(t, None);
+        }
     }
 }
