@@ -1,5 +1,6 @@
 //! Rigid bodies: a convex polygon with density, restitution and state (SPEC §2.2).
 
+use crate::limits;
 use crate::math::{Rot, Vec2, cross, cross_scalar};
 use crate::shape::ConvexPolygon;
 use thiserror::Error;
@@ -25,12 +26,10 @@ pub enum BodyError {
     BadFriction(f64),
     #[error("position and angle must be finite")]
     NonFinitePlacement,
+    /// A number beyond its limit in `crate::limits`: what, value, limit.
+    #[error("{0} {1:e} is beyond ±{2:e}")]
+    Beyond(&'static str, f64, f64),
 }
-
-/// The largest friction coefficient a body or world may have: far beyond any material,
-/// and far below where μ times an impulse overflows (a μ of 1e300 turned a sliding
-/// contact's friction bound to infinity and its impulse to NaN).
-pub const MAX_FRICTION: f64 = 1e6;
 
 /// Everything needed to make a body: shape, material and where it starts.
 #[derive(Debug, Clone)]
@@ -129,7 +128,7 @@ impl Body {
             return Err(BodyError::BadRestitution(def.restitution));
         }
         if let Some(mu) = def.friction
-            && !(0.0..=MAX_FRICTION).contains(&mu)
+            && !(0.0..=limits::FRICTION).contains(&mu)
         {
             return Err(BodyError::BadFriction(mu));
         }
@@ -140,6 +139,20 @@ impl Body {
             || !def.angular_velocity.is_finite()
         {
             return Err(BodyError::NonFinitePlacement);
+        }
+        let vertices = def.polygon.vertices().iter().flat_map(|v| [v.x, v.y]);
+        let numbers = [
+            ("density", def.density, limits::DENSITY),
+            ("x", def.origin.x, limits::COORDINATE),
+            ("y", def.origin.y, limits::COORDINATE),
+            ("angle", def.angle, limits::ANGLE),
+            ("speed", def.velocity.norm(), limits::SPEED),
+            ("spin", def.angular_velocity, limits::SPIN),
+        ]
+        .into_iter()
+        .chain(vertices.map(|v| ("vertex coordinate", v, limits::COORDINATE)));
+        if let Some((what, value, limit)) = limits::first_beyond(numbers) {
+            return Err(BodyError::Beyond(what, value, limit));
         }
         let mp = def.polygon.mass_properties();
         let local_vertices: Vec<Vec2> = def

@@ -18,6 +18,7 @@
 
 pub mod body;
 pub mod collide;
+pub mod limits;
 pub mod math;
 pub mod shape;
 pub mod solver;

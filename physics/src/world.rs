@@ -139,6 +139,8 @@ pub enum JointError {
     SameBody,
     #[error("the joint anchor is not a finite point")]
     NonFiniteAnchor,
+    #[error("the joint anchor coordinate {0:e} is beyond ±{1:e}")]
+    AnchorBeyond(f64, f64),
     #[error("joint {0}")]
     BadMotor(MotorError),
 }
@@ -148,7 +150,7 @@ pub enum JointError {
 pub enum StepError {
     #[error("the time step must be a finite number > 0, got {0}")]
     BadTimeStep(f64),
-    #[error("gravity must be finite, got ({0}, {1})")]
+    #[error("gravity must be finite and within ±{max:e} per axis, got ({0}, {1})", max = crate::limits::GRAVITY)]
     BadGravity(f64, f64),
     #[error("the world's friction must be a number in [0, 1e6], got {0}")]
     BadFriction(f64),
@@ -304,6 +306,10 @@ impl World {
     pub fn add_joint(&mut self, def: JointDef) -> Result<JointHandle, JointError> {
         if !(def.anchor.x.is_finite() && def.anchor.y.is_finite()) {
             return Err(JointError::NonFiniteAnchor);
+        }
+        let far = def.anchor.x.abs().max(def.anchor.y.abs());
+        if far > crate::limits::COORDINATE {
+            return Err(JointError::AnchorBeyond(far, crate::limits::COORDINATE));
         }
         if Some(def.body_a) == def.body_b {
             return Err(JointError::SameBody);
@@ -482,17 +488,18 @@ impl World {
         let _refused = self.try_step(dt);
     }
 
-    /// `step`, refusing a time step that is not finite and positive, non-finite gravity
-    /// or a world friction that is not a finite number ≥ 0, with the reason. (Bodies,
-    /// joints and motors are checked when they are added.)
+    /// `step`, refusing a time step that is not finite and positive, gravity or a world
+    /// friction (≥ 0) that is not finite or beyond its limit in `crate::limits`, with the
+    /// reason. (Bodies, joints and motors are checked when they are added.)
     pub fn try_step(&mut self, dt: f64) -> Result<(), StepError> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepError::BadTimeStep(dt));
         }
-        if !(self.gravity.x.is_finite() && self.gravity.y.is_finite()) {
+        let g = crate::limits::GRAVITY;
+        if !(self.gravity.x.abs() <= g && self.gravity.y.abs() <= g) {
             return Err(StepError::BadGravity(self.gravity.x, self.gravity.y));
         }
-        if !(0.0..=crate::body::MAX_FRICTION).contains(&self.friction) {
+        if !(0.0..=crate::limits::FRICTION).contains(&self.friction) {
             return Err(StepError::BadFriction(self.friction));
         }
         self.advance(dt);

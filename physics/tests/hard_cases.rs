@@ -727,6 +727,42 @@ fn numbers_that_would_poison_the_state_are_refused() {
     let mut pin = JointDef::new(a, Some(b), Vec2::new(0.5, 0.0));
     pin.motor = Some(JointMotor::new(f64::NAN, 1.0));
     assert!(matches!(w.add_joint(pin), Err(JointError::BadMotor(_))));
+    // Finite but absurd magnitudes (`pe::limits`): the fuzzer found that a gravity of
+    // 1e308 or a motor torque of 1e300 overflowed the first step.
+    let unit = || ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let beyond = |def: BodyDef| match World::new(Vec2::zeros()).add_body(def) {
+        Err(pe::BodyError::Beyond(what, ..)) => what,
+        other => panic!("accepted or refused for another reason: {other:?}"),
+    };
+    assert_eq!(beyond(BodyDef::new(unit(), 1e200)), "density");
+    assert_eq!(
+        beyond(BodyDef::new(unit(), 1.0).at(Vec2::new(1e300, 0.0), 0.0)),
+        "x"
+    );
+    assert_eq!(
+        beyond(BodyDef::new(unit(), 1.0).at(Vec2::zeros(), 1e300)),
+        "angle"
+    );
+    let fast = BodyDef::new(unit(), 1.0).velocity(Vec2::new(0.0, 1e300), 0.0);
+    assert_eq!(beyond(fast), "speed");
+    let huge = ConvexPolygon::rectangle(4e9, 4e9).unwrap();
+    assert_eq!(beyond(BodyDef::new(huge, 1.0)), "vertex coordinate");
+    let strong = BodyMotor::new(0, 10, 0.1, 1e300, 1e300, 0.0);
+    assert!(matches!(
+        w.add_body_motor(a, strong),
+        Err(MotorError::Beyond("start torque", ..))
+    ));
+    let mut pin = JointDef::new(a, Some(b), Vec2::new(0.5, 0.0));
+    pin.motor = Some(JointMotor::new(1.0, 1e300));
+    assert!(matches!(
+        w.add_joint(pin),
+        Err(JointError::BadMotor(MotorError::Beyond("max torque", ..)))
+    ));
+    let far = JointDef::new(a, Some(b), Vec2::new(0.5, 1e300));
+    assert!(matches!(
+        w.add_joint(far),
+        Err(JointError::AnchorBeyond(..))
+    ));
     assert!(w.body_motors().is_empty() && w.joints().next().is_none());
     // Steps: the reason is given and nothing moves.
     let before: Vec<_> = w.bodies().map(|(_, b)| (b.position, b.velocity)).collect();
@@ -734,8 +770,10 @@ fn numbers_that_would_poison_the_state_are_refused() {
         assert!(matches!(w.try_step(dt), Err(StepError::BadTimeStep(_))));
         w.step(dt);
     }
-    w.gravity = Vec2::new(0.0, f64::NAN);
-    assert!(matches!(w.try_step(H), Err(StepError::BadGravity(..))));
+    for g in [f64::NAN, 1e308] {
+        w.gravity = Vec2::new(0.0, g);
+        assert!(matches!(w.try_step(H), Err(StepError::BadGravity(..))));
+    }
     w.gravity = Vec2::new(0.0, 10.0);
     for mu in [-1.0, 1e300, f64::NAN] {
         w.friction = mu;

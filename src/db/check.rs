@@ -11,23 +11,11 @@ use std::collections::BTreeMap;
 /// making sense (SPEC §6.1 recommends 0.01–0.1; we allow a decade either side).
 pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
 
-/// The largest magnitude each kind of number may have. They are far beyond anything a
-/// robot needs (issue 9's extreme-but-legal input: coordinates of 1e6, density ratios of
-/// 1e6, torques of 1e12) and far below where a step overflows (the fuzzer found that a
-/// gravitation of 1e308 or a startTorque of 1e300 passed the finite checks and turned the
-/// first step to infinity).
-pub mod limits {
-    pub const COORDINATE: f64 = 1e9;
-    pub const ANGLE: f64 = 1e6;
-    pub const DENSITY: f64 = 1e12;
-    pub const FRICTION: f64 = 1e6;
-    pub const GRAVITATION: f64 = 1e9;
-    pub const TORQUE: f64 = 1e15;
-    /// Motor speed, radians per step.
-    pub const ANGULAR: f64 = 1e6;
-    /// A body motor's ramp, fraction of startTorque per step.
-    pub const INCREASE: f64 = 1e6;
-}
+/// The largest magnitude each kind of number may have: the engine's own, so that what
+/// passes here is what `pe` accepts (each placement is checked as written; a world
+/// position that only the sum of a robot's and its body's placement puts beyond the limit
+/// is refused by `pe` when the scene is built).
+pub use pe::limits;
 
 /// "`what` {value} is larger than {limit}" when `value` exceeds `limit` in magnitude.
 pub fn beyond(what: &str, value: f64, limit: f64) -> Option<String> {
@@ -317,7 +305,7 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
     }
     for message in beyond_all(&[
         ("friction", scene.friction, limits::FRICTION),
-        ("gravitation", scene.gravitation, limits::GRAVITATION),
+        ("gravitation", scene.gravitation, limits::GRAVITY),
     ]) {
         error(message);
     }

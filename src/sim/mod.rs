@@ -148,16 +148,7 @@ impl Simulation {
             .body(&placement.source)
             .ok_or_else(|| format!("{id}: source \"{}\" is not a body", placement.source))?;
         let polygon = db::polygon(def).map_err(|e| format!("{id}: body \"{}\": {e}", def.name))?;
-        let numbers = [
-            ("density", def.density, limits::DENSITY),
-            ("friction", def.friction.unwrap_or(0.0), limits::FRICTION),
-            ("x", at.0.x, limits::COORDINATE),
-            ("y", at.0.y, limits::COORDINATE),
-            ("orientation", at.1, limits::ANGLE),
-        ];
-        if let Some(message) = beyond_all(&numbers).into_iter().next() {
-            return Err(format!("{id}: {message}"));
-        }
+        // Density, friction and placement are checked by `pe` (its limits, its words).
         let mut body = BodyDef::new(polygon, def.density)
             .restitution(def.cor)
             .at(at.0, at.1);
@@ -177,8 +168,10 @@ impl Simulation {
     }
 
     fn populate(&mut self, scene: &Scene) -> Result<(), String> {
-        // The checks `pe` leaves to its caller (the editor simulates a model whatever its
-        // problems, so what `db::check` reports must not reach the engine either).
+        // The editor simulates a model whatever its problems, so what `db::check` reports
+        // must not reach the engine either. `pe` refuses gravity and friction only when
+        // stepping, and a motor's numbers in its own units: these are refused here, when
+        // the scene is built, in the XML's words.
         if !(scene.friction.is_finite() && scene.friction >= 0.0) {
             return Err(format!(
                 "friction {} is not a finite number ≥ 0",
@@ -193,7 +186,7 @@ impl Simulation {
         }
         if let Some(message) = beyond_all(&[
             ("friction", scene.friction, limits::FRICTION),
-            ("gravitation", scene.gravitation, limits::GRAVITATION),
+            ("gravitation", scene.gravitation, limits::GRAVITY),
         ])
         .into_iter()
         .next()

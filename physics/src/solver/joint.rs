@@ -65,7 +65,7 @@ pub struct JointMotor {
 }
 
 impl JointMotor {
-    /// Both numbers finite, the torque bound non-negative.
+    /// Both numbers finite and within `crate::limits`, the torque bound non-negative.
     pub fn validate(&self) -> Result<(), super::motor::MotorError> {
         use super::motor::MotorError;
         if !self.target_speed.is_finite() {
@@ -76,6 +76,13 @@ impl JointMotor {
         }
         if self.max_torque < 0.0 {
             return Err(MotorError::Negative("max torque", self.max_torque));
+        }
+        let numbers = [
+            ("target speed", self.target_speed, crate::limits::SPIN),
+            ("max torque", self.max_torque, crate::limits::TORQUE),
+        ];
+        if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
+            return Err(MotorError::Beyond(what, value, limit));
         }
         Ok(())
     }

@@ -8,6 +8,9 @@ pub enum MotorError {
     NonFinite(&'static str, f64),
     #[error("motor {0} must not be negative, got {1}")]
     Negative(&'static str, f64),
+    /// A number beyond its limit in `crate::limits`: what, value, limit.
+    #[error("motor {0} {1:e} is beyond ±{2:e}")]
+    Beyond(&'static str, f64, f64),
 }
 
 /// A body motor with the XML `<force>` fields. Times count steps; `angular` is radians per
@@ -63,6 +66,16 @@ impl BodyMotor {
             if *value < 0.0 {
                 return Err(MotorError::Negative(name, *value));
             }
+        }
+        let limits = [
+            crate::limits::ANGULAR,
+            crate::limits::TORQUE,
+            crate::limits::TORQUE,
+            crate::limits::INCREASE,
+        ];
+        let numbers = fields.iter().zip(limits).map(|(&(n, v), l)| (n, v, l));
+        if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
+            return Err(MotorError::Beyond(what, value, limit));
         }
         Ok(())
     }

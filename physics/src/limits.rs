@@ -1,0 +1,38 @@
+//! The largest magnitude each kind of number may have in a world. They are far beyond
+//! anything a robot or a benchmark needs (issue 9's extreme-but-legal input: coordinates
+//! of 1e6, density ratios of 1e6, torques of 1e12) and far below where a step overflows:
+//! the fuzzer found that a gravitation of 1e308 or a motor torque of 1e300 passed the
+//! finiteness checks and turned the first step to infinity. Bodies, joints, motors and
+//! steps beyond them are refused with an error naming the number.
+
+/// Positions, anchors and polygon vertices (length units).
+pub const COORDINATE: f64 = 1e9;
+/// Body angles (radians).
+pub const ANGLE: f64 = 1e6;
+/// Mass per unit area.
+pub const DENSITY: f64 = 1e12;
+/// Friction coefficients, of bodies and of the world: μ times an impulse must not overflow.
+pub const FRICTION: f64 = 1e6;
+/// Each component of gravity (length units / s²).
+pub const GRAVITY: f64 = 1e9;
+/// Motor torques.
+pub const TORQUE: f64 = 1e15;
+/// Body velocities (length units / s).
+pub const SPEED: f64 = 1e9;
+/// Body spins and joint motor speeds (radians / s): a body motor's fastest speed per step
+/// ([`ANGULAR`]) at a step of 1e-4 s.
+pub const SPIN: f64 = 1e10;
+/// A body motor's speed, radians per step (SPEC §4.4).
+pub const ANGULAR: f64 = 1e6;
+/// A body motor's torque ramp, fraction of its start torque per step.
+pub const INCREASE: f64 = 1e6;
+
+/// `Some((what, value, limit))` for the first `(what, value, limit)` whose value is beyond
+/// its limit in magnitude (NaN counts as beyond).
+pub fn first_beyond(
+    numbers: impl IntoIterator<Item = (&'static str, f64, f64)>,
+) -> Option<(&'static str, f64, f64)> {
+    numbers
+        .into_iter()
+        .find(|&(_, value, limit)| value.is_nan() || value.abs() > limit)
+}
