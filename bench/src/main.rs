@@ -8,6 +8,7 @@ mod box2d_scenes;
 mod harness;
 mod pe_scenes;
 mod rapier_scenes;
+mod robots;
 mod scene;
 mod sweep;
 
@@ -156,7 +157,8 @@ fn main() {
         box2d_scenes::smash,
     ));
     let narrow = narrow_phase_rows(&rows);
-    let report = report(&rows, &narrow, started.elapsed(), &load);
+    let robot_rows = robots::run();
+    let report = report(&rows, &narrow, &robot_rows, started.elapsed(), &load);
     write_doc(docs, "results.md", &report);
 }
 
@@ -255,7 +257,13 @@ fn ratio(pe: Duration, peer: Duration) -> String {
     }
 }
 
-fn report(rows: &[Row], narrow: &[NarrowRow], elapsed: Duration, load: &str) -> String {
+fn report(
+    rows: &[Row],
+    narrow: &[NarrowRow],
+    robot_rows: &[robots::RobotRow],
+    elapsed: Duration,
+    load: &str,
+) -> String {
     let names: Vec<&str> = PE_SOLVERS.iter().map(|s| s.name()).collect();
     let mut md = String::new();
     let w = &mut md;
@@ -382,6 +390,28 @@ fn report(rows: &[Row], narrow: &[NarrowRow], elapsed: Duration, load: &str) -> 
             metric_cell(&r.reuse),
             metric_cell(&r.fresh)
         );
+    }
+
+    let _ = writeln!(w, "\n## Robots of the default database (pe only)\n");
+    let _ = writeln!(
+        w,
+        "The scenes of data/ as the app and the CLI run them (`robosim::sim::Simulation`, \
+         motors on, {} steps at the scene's time step), under each contact solver: median \
+         time per step, and in brackets the widest any joint opened during the run (px). \
+         The peers have no thesis motors, so there is no peer column.\n",
+        robots::STEPS
+    );
+    let solvers: Vec<String> = robots::SOLVERS
+        .iter()
+        .map(|s| format!("pe {}", s.name()))
+        .collect();
+    let _ = writeln!(w, "{}", table_head(&["scene"], &solvers, "---:"));
+    for r in robot_rows {
+        let _ = write!(w, "| {} |", r.scene);
+        for (timing, widest) in &r.runs {
+            let _ = write!(w, " {} ({widest:.1e}) |", time_cell(timing));
+        }
+        let _ = writeln!(w);
     }
     md
 }
