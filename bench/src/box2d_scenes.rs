@@ -7,8 +7,9 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, PeerBody, Pendulum, PeriodTracker,
+    Pyramid, PyramidTracker, ReboundTracker, bounce, chain, joint_grid,
+    momentum_and_kinetic_energy, smash, worst,
 };
 use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
 
@@ -98,15 +99,20 @@ pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
-/// Kinetic plus gravitational energy of one body, from its mass properties.
-fn energy(world: &World, body: BodyId) -> f64 {
-    let mass = f64::from(world.body_mass(body));
-    let inertia = f64::from(world.body_rotational_inertia(body));
+/// One body's motion, from its mass properties.
+fn motion(world: &World, body: BodyId) -> PeerBody {
     let v = world.body_linear_velocity(body);
-    let omega = f64::from(world.body_angular_velocity(body));
-    let (vx, vy) = (f64::from(v.x), f64::from(v.y));
-    let kinetic = 0.5 * mass * (vx * vx + vy * vy) + 0.5 * inertia * omega * omega;
-    kinetic + mass * G * f64::from(world.body_world_center_of_mass(body).y)
+    PeerBody {
+        mass: f64::from(world.body_mass(body)),
+        inertia: f64::from(world.body_rotational_inertia(body)),
+        velocity: (f64::from(v.x), f64::from(v.y)),
+        omega: f64::from(world.body_angular_velocity(body)),
+        height: f64::from(world.body_world_center_of_mass(body).y),
+    }
+}
+
+fn energy(world: &World, body: BodyId) -> f64 {
+    motion(world, body).energy()
 }
 
 /// A pin between two bodies, remembered by its anchor in each body's frame so that its gap
@@ -258,19 +264,7 @@ pub fn smash() -> Outcome {
     );
     w.set_body_linear_velocity(heavy, Vec2::new(smash::SPEED as f32, 0.0));
     bodies.push(heavy);
-    let totals = |w: &World| {
-        let (mut p, mut e) = ((0.0, 0.0), 0.0);
-        for &b in &bodies {
-            let m = f64::from(w.body_mass(b));
-            let i = f64::from(w.body_rotational_inertia(b));
-            let v = w.body_linear_velocity(b);
-            let (vx, vy) = (f64::from(v.x), f64::from(v.y));
-            let omega = f64::from(w.body_angular_velocity(b));
-            p = (p.0 + m * vx, p.1 + m * vy);
-            e += 0.5 * m * (vx * vx + vy * vy) + 0.5 * i * omega * omega;
-        }
-        (p, e)
-    };
+    let totals = |w: &World| momentum_and_kinetic_energy(bodies.iter().map(|&b| motion(w, b)));
     let (p0, e0) = totals(&w);
     let mut tracker = MomentumTracker::new(p0, e0);
     let timing = measure(

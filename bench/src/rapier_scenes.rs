@@ -5,8 +5,9 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
+    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, PeerBody, Pendulum, PeriodTracker,
+    Pyramid, PyramidTracker, ReboundTracker, bounce, chain, joint_grid,
+    momentum_and_kinetic_energy, smash, worst,
 };
 use rapier2d::prelude::*;
 
@@ -79,15 +80,21 @@ pub fn pyramid(spec: &Pyramid, h: f64, iterations: usize) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
-/// Kinetic plus gravitational energy of one body, computed here from its mass properties
-/// so that both engines' energies mean the same thing.
-fn energy(world: &PhysicsWorld, body: RigidBodyHandle) -> f64 {
+/// One body's motion, from its mass properties.
+fn motion(world: &PhysicsWorld, body: RigidBodyHandle) -> PeerBody {
     let b = &world.bodies[body];
-    let mass = f64::from(b.mass());
-    let inertia = f64::from(b.mass_properties().local_mprops.principal_inertia());
-    let (v, omega) = (b.linvel(), f64::from(b.angvel()));
-    let kinetic = 0.5 * mass * f64::from(v.length_squared()) + 0.5 * inertia * omega * omega;
-    kinetic + mass * G * f64::from(b.center_of_mass().y)
+    let v = b.linvel();
+    PeerBody {
+        mass: f64::from(b.mass()),
+        inertia: f64::from(b.mass_properties().local_mprops.principal_inertia()),
+        velocity: (f64::from(v.x), f64::from(v.y)),
+        omega: f64::from(b.angvel()),
+        height: f64::from(b.center_of_mass().y),
+    }
+}
+
+fn energy(world: &PhysicsWorld, body: RigidBodyHandle) -> f64 {
+    motion(world, body).energy()
 }
 
 pub fn pendulum(spec: &Pendulum, iterations: usize) -> Outcome {
@@ -197,20 +204,8 @@ pub fn smash() -> Outcome {
     for &b in &bodies {
         set[b].recompute_mass_properties_from_colliders(colliders);
     }
-    let totals = |w: &PhysicsWorld| {
-        let (mut p, mut e) = ((0.0, 0.0), 0.0);
-        for &b in &bodies {
-            let body = &w.bodies[b];
-            let m = f64::from(body.mass());
-            let v = body.linvel();
-            let (vx, vy) = (f64::from(v.x), f64::from(v.y));
-            let i = f64::from(body.mass_properties().local_mprops.principal_inertia());
-            let omega = f64::from(body.angvel());
-            p = (p.0 + m * vx, p.1 + m * vy);
-            e += 0.5 * m * (vx * vx + vy * vy) + 0.5 * i * omega * omega;
-        }
-        (p, e)
-    };
+    let totals =
+        |w: &PhysicsWorld| momentum_and_kinetic_energy(bodies.iter().map(|&b| motion(w, b)));
     let (p0, e0) = totals(&w);
     let mut tracker = MomentumTracker::new(p0, e0);
     let timing = measure(&mut w, smash::STEPS, PhysicsWorld::step, |w, _| {

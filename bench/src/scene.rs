@@ -19,6 +19,42 @@ pub const BOX: f64 = 1.0;
 /// Size of the static floor, m (its top face at y = 0, or at each `Pyramid::floor_tops`).
 pub const FLOOR: (f64, f64) = (200.0, 1.0);
 
+/// A peer body's motion in f64, read from its engine, so that both peers' energies and
+/// momenta are computed the same way (pe has its own, in f64 already).
+#[derive(Debug, Clone, Copy)]
+pub struct PeerBody {
+    pub mass: f64,
+    pub inertia: f64,
+    pub velocity: (f64, f64),
+    pub omega: f64,
+    /// Height of the centre of mass (y up).
+    pub height: f64,
+}
+
+impl PeerBody {
+    pub fn kinetic_energy(&self) -> f64 {
+        let (vx, vy) = self.velocity;
+        0.5 * self.mass * (vx * vx + vy * vy) + 0.5 * self.inertia * self.omega * self.omega
+    }
+
+    /// Kinetic plus gravitational energy.
+    pub fn energy(&self) -> f64 {
+        self.kinetic_energy() + self.mass * G * self.height
+    }
+
+    pub fn momentum(&self) -> (f64, f64) {
+        (self.mass * self.velocity.0, self.mass * self.velocity.1)
+    }
+}
+
+/// Total linear momentum and kinetic energy of `bodies`.
+pub fn momentum_and_kinetic_energy(bodies: impl Iterator<Item = PeerBody>) -> ((f64, f64), f64) {
+    bodies.fold(((0.0, 0.0), 0.0), |((px, py), e), b| {
+        let (bx, by) = b.momentum();
+        ((px + bx, py + by), e + b.kinetic_energy())
+    })
+}
+
 /// The larger of a running worst value and a new sample, where a NaN sample (an engine
 /// that blew up) counts as infinitely bad rather than being skipped as `f64::max` would.
 pub fn worst(so_far: f64, sample: f64) -> f64 {
