@@ -565,8 +565,10 @@ impl World {
             // Fast bodies, and bodies an impact sent further than the contact margin (their
             // contacts were found before the solve, for the motion they had then). A
             // jointed body only when fast enough to pass through something: its whole
-            // mechanism goes back with it (below), and a wheel pressed a little deep into
-            // terrain would hold the car back every step; that is the contacts' job.
+            // mechanism goes back with it (below), and a robot's feet pressed a little deep
+            // into the ground are the contacts' job. (Measured with the margin rule for
+            // jointed bodies too: the walker under `thesis` got 57% less far in 1,000
+            // steps, and the car's pins under `exact` opened 2.8e-3 px instead of 2e-5.)
             let fast = 0.5 * body.inner_radius();
             let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
             if motion <= if jointed { fast } else { fast.min(margin) } {
