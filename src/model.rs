@@ -181,6 +181,10 @@ impl Model {
         self.bodies.iter().find(|b| same_name(&b.name, name))
     }
 
+    pub fn body_mut(&mut self, name: &str) -> Option<&mut BodyDef> {
+        self.bodies.iter_mut().find(|b| same_name(&b.name, name))
+    }
+
     pub fn robot(&self, name: &str) -> Option<&Robot> {
         self.robots.iter().find(|r| same_name(&r.name, name))
     }
@@ -191,5 +195,9 @@ impl Model {
 
     pub fn scene(&self, name: &str) -> Option<&Scene> {
         self.scenes.iter().find(|s| same_name(&s.name, name))
+    }
+
+    pub fn scene_mut(&mut self, name: &str) -> Option<&mut Scene> {
+        self.scenes.iter_mut().find(|s| same_name(&s.name, name))
     }
 }

@@ -5,7 +5,9 @@ use proptest::prelude::*;
 use robosim::db::{
     Database, Delete, EditError, FileKind, Overwrite, Problem, SaveError, Severity, User,
 };
-use robosim::model::{BodyDef, JointDef, Model, Placement, Robot, RobotBody, Scene, SceneRobot};
+use robosim::model::{
+    BodyDef, JointDef, Model, Placement, Robot, RobotBody, Scene, SceneRobot, same_name,
+};
 use std::path::Path;
 
 const BOX_BODIES: &str = r#"<bodies>
@@ -760,16 +762,22 @@ fn rename_and_delete_follow_names_with_surrounding_spaces() {
     let index = model.bodies.iter().position(|b| b.name == body).unwrap();
     let stored = format!(" {body} ");
     model.bodies[index].name = stored.clone();
+    // The robot's joints name their bodies with spaces around the aliases, too.
+    for j in &mut model.robots[0].joints {
+        j.body_a = format!(" {} ", j.body_a);
+        j.body_b = format!(" {} ", j.body_b);
+    }
+    assert!(!model.robots[0].joints.is_empty());
     let uses = |m: &Model, name: &str| {
         m.robots
             .iter()
             .flat_map(|r| &r.bodies)
-            .filter(|b| b.placement.source.trim() == name)
+            .filter(|b| same_name(&b.placement.source, name))
             .count()
             + m.scenes
                 .iter()
                 .flat_map(|s| &s.bodies)
-                .filter(|b| b.source.trim() == name)
+                .filter(|b| same_name(&b.source, name))
                 .count()
     };
     let before = uses(&model, &body);
@@ -780,4 +788,11 @@ fn rename_and_delete_follow_names_with_surrounding_spaces() {
     model.bodies[index].name = " renamed ".into();
     model.delete_body(" renamed ", Delete::Cascade).unwrap();
     assert_eq!(uses(&model, "renamed"), 0);
+    // No joint is left pinning a body the cascade removed.
+    for r in &model.robots {
+        for j in &r.joints {
+            let placed = |alias: &str| r.body(alias).is_some();
+            assert!(placed(&j.body_a) && placed(&j.body_b), "{}: {j:?}", r.name);
+        }
+    }
 }

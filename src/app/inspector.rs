@@ -34,7 +34,7 @@ pub fn show(
     let robot_names: Vec<String> = draft.robots.iter().map(|r| r.name.clone()).collect();
     match selection {
         Selection::Body(name) => {
-            let Some(body) = draft.bodies.iter_mut().find(|b| &b.name == name) else {
+            let Some(body) = draft.body_mut(name) else {
                 return change;
             };
             if let Some(new) = name_field(ui, name, name_buffer) {
@@ -254,7 +254,7 @@ pub fn show(
                 .and_then(|r| r.bodies.last())
                 .and_then(|b| draft.body(&b.placement.source))
                 .map_or(0.0, width_along_x);
-            let Some(robot) = draft.robots.iter_mut().find(|r| &r.name == name) else {
+            let Some(robot) = draft.robot_mut(name) else {
                 return change;
             };
             if let Some(new) = name_field(ui, name, name_buffer) {
@@ -370,7 +370,7 @@ pub fn show(
             motor_timeline(ui, robot);
         }
         Selection::Scene(name) => {
-            let Some(scene) = draft.scenes.iter_mut().find(|s| &s.name == name) else {
+            let Some(scene) = draft.scene_mut(name) else {
                 return change;
             };
             if let Some(new) = name_field(ui, name, name_buffer) {

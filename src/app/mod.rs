@@ -898,7 +898,7 @@ impl RoboSimApp {
             ) {
                 canvas::VertexEdit::Changed(new) => {
                     let mut draft = self.db.model.clone();
-                    if let Some(b) = draft.bodies.iter_mut().find(|b| b.name == name) {
+                    if let Some(b) = draft.body_mut(&name) {
                         b.vertices = new;
                     }
                     let key = format!("vertex {:?}", self.vertex_drag);
@@ -1020,7 +1020,7 @@ impl RoboSimApp {
         let mut draft = self.db.model.clone();
         match (&self.selection, body.placed_by) {
             (Some(Selection::Scene(name)), placed_by) => {
-                let Some(scene) = draft.scenes.iter_mut().find(|s| &s.name == name) else {
+                let Some(scene) = draft.scene_mut(name) else {
                     return;
                 };
                 let placement = match placed_by {
@@ -1040,12 +1040,7 @@ impl RoboSimApp {
             }
             // The robot preview places the robot alone at the origin.
             (Some(Selection::Robot(name)), PlacedBy::RobotBody { body: k, .. }) => {
-                let Some(b) = draft
-                    .robots
-                    .iter_mut()
-                    .find(|r| &r.name == name)
-                    .and_then(|r| r.bodies.get_mut(k))
-                else {
+                let Some(b) = draft.robot_mut(name).and_then(|r| r.bodies.get_mut(k)) else {
                     return;
                 };
                 let p = &mut b.placement;

@@ -3,7 +3,7 @@
 //! directly.
 
 use crate::db::outline_polygon;
-use crate::model::{JointDef, Model, Placement, Robot};
+use crate::model::{JointDef, Model, Placement, Robot, same_name};
 use pe::Vec2;
 
 /// What a click on the canvas does in a robot or scene (the body editor has its own).
@@ -122,7 +122,8 @@ pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDe
     // bodyA is the one drawn below, as the thesis's robots list the carrier first.
     let (body_a, body_b) = (b, a);
     if robot.joints.iter().any(|j| {
-        (j.body_a == body_a && j.body_b == body_b) || (j.body_a == body_b && j.body_b == body_a)
+        let pins = |a: &str, b: &str| same_name(&j.body_a, a) && same_name(&j.body_b, b);
+        pins(&body_a, &body_b) || pins(&body_b, &body_a)
     }) {
         return Err(format!("{body_a} and {body_b} are already pinned together"));
     }

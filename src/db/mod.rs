@@ -383,7 +383,6 @@ pub enum Delete {
 impl Model {
     /// Robots and scenes that place the body `name`.
     pub fn body_users(&self, name: &str) -> Vec<User> {
-        let name = name.trim();
         let mut users: Vec<User> = self
             .robots
             .iter()
@@ -405,7 +404,6 @@ impl Model {
 
     /// Scenes that place the robot `name`.
     pub fn robot_users(&self, name: &str) -> Vec<User> {
-        let name = name.trim();
         self.scenes
             .iter()
             .filter(|s| s.robots.iter().any(|r| same_name(&r.source, name)))
@@ -513,9 +511,10 @@ impl Model {
             robot
                 .bodies
                 .retain(|b| !same_name(&b.placement.source, name));
+            let was_removed = |alias: &str| removed.iter().any(|r| same_name(r, alias));
             robot
                 .joints
-                .retain(|j| !removed.contains(&j.body_a) && !removed.contains(&j.body_b));
+                .retain(|j| !was_removed(&j.body_a) && !was_removed(&j.body_b));
         }
         for scene in &mut self.scenes {
             scene.bodies.retain(|b| !same_name(&b.source, name));

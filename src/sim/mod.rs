@@ -4,7 +4,7 @@
 pub mod trace;
 
 use crate::db::{self, beyond_all, limits};
-use crate::model::{Model, Placement, Scene};
+use crate::model::{Model, Placement, Scene, same_name};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
 
 /// Why a scene cannot be simulated.
@@ -248,7 +248,7 @@ impl Simulation {
             let find = |alias: &str| {
                 handles
                     .iter()
-                    .find(|(a, _)| a == alias.trim())
+                    .find(|(a, _)| same_name(a, alias))
                     .map(|(_, h)| *h)
             };
             for j in &robot.joints {
