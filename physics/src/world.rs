@@ -281,7 +281,6 @@ impl World {
         self.bodies.get_mut(handle.index())?.as_mut()
     }
 
-    /// Live bodies in handle order.
     /// The median bounding radius of the bodies that can move (none: `None`): the size of
     /// a typical body, for `StepSettings::length_scale` in a scene not in metres.
     pub fn median_body_radius(&self) -> Option<f64> {
@@ -294,6 +293,7 @@ impl World {
         sizes.get(sizes.len() / 2).copied()
     }
 
+    /// Live bodies in handle order.
     pub fn bodies(&self) -> impl Iterator<Item = (BodyHandle, &Body)> {
         self.bodies
             .iter()
