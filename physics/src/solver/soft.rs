@@ -180,6 +180,9 @@ pub struct SoftStepSolver {
     memory: ContactMemory,
     recalled: Vec<(f64, f64)>,
     joint_memory: Vec<(u32, Vec2, f64)>,
+    /// The memory of pins left out this step (both bodies fixed: asleep, or held under
+    /// `auto`), kept so that they warm-start again when their bodies move.
+    skipped_joint_memory: Vec<(u32, Vec2, f64)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
     joint_islands: Vec<(usize, usize)>,
     island_uf: UnionFind,
@@ -332,6 +335,7 @@ impl SoftStepSolver {
             }
         }
         self.joints.clear();
+        self.skipped_joint_memory.clear();
         for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
             // A pin between two fixed bodies (asleep, or held for the other solver's pass
@@ -339,6 +343,10 @@ impl SoftStepSolver {
             // motor's reading (the other pass's) is touched.
             let fixed = |b: &SolverBody| b.inv_mass == 0.0 && b.inv_inertia == 0.0;
             if fixed(a) && fixed(b) {
+                let memory = self.joint_memory.binary_search_by(|m| m.0.cmp(&j.joint));
+                if let Ok(k) = memory {
+                    self.skipped_joint_memory.push(self.joint_memory[k]);
+                }
                 continue;
             }
             let (r_a, r_b) = j.arms((a.angle, b.angle));
@@ -609,6 +617,8 @@ impl SoftStepSolver {
                 m.step_impulse = j.motor_step_total;
             }
         }
+        self.joint_memory
+            .extend_from_slice(&self.skipped_joint_memory);
         self.joint_memory.sort_unstable_by_key(|x| x.0);
     }
 }
