@@ -208,10 +208,7 @@ impl Body {
     }
     pub(crate) fn fall_asleep(&mut self) {
         self.asleep = true;
-        self.velocity = Vec2::zeros();
-        self.angular_velocity = 0.0;
-        self.inv_mass = 0.0;
-        self.inv_inertia = 0.0;
+        self.hold();
     }
     /// Held still, as if asleep, for one pass of a step that moves the rest of the world
     /// (a body of the other solver's islands under `ContactSolver::Auto`). Returns its
@@ -225,13 +222,16 @@ impl Body {
         velocity
     }
     pub(crate) fn release(&mut self, (velocity, angular_velocity): (Vec2, f64)) {
-        self.inv_mass = self.inv_mass();
-        self.inv_inertia = self.inv_inertia();
+        self.movable_again();
         (self.velocity, self.angular_velocity) = (velocity, angular_velocity);
     }
     pub(crate) fn wake(&mut self) {
         self.asleep = false;
         self.still_time = 0.0;
+        self.movable_again();
+    }
+    /// The inverse mass and inertia back from the mass properties (see `hold`).
+    fn movable_again(&mut self) {
         self.inv_mass = self.inv_mass();
         self.inv_inertia = self.inv_inertia();
     }
