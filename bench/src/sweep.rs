@@ -148,13 +148,13 @@ fn scenes() -> [Scene; 5] {
             },
         },
         Scene {
-            name: "stack10",
+            name: STACKS[0].name,
             error_name: "top box's sideways drift + sag over 10 s (boxes)",
             run: |engine, h| stack(&STACKS[0], engine, h),
             error: stack_error,
         },
         Scene {
-            name: "stack20",
+            name: STACKS[1].name,
             error_name: "top box's sideways drift + sag over 10 s (boxes)",
             run: |engine, h| stack(&STACKS[1], engine, h),
             error: stack_error,
