@@ -301,4 +301,46 @@ mod tests {
             "both bodies served as reference"
         );
     }
+
+    /// The two other refusals: a margin wider than the cached manifold's (it may have left
+    /// points out), and cached points beyond a narrower margin, which are dropped as a
+    /// fresh test would leave them out.
+    #[test]
+    fn a_wider_margin_asks_afresh_and_a_narrower_one_drops_far_points() {
+        let slab: Vec<Vec2> = [(-3.0, -0.5), (3.0, -0.5), (3.0, 0.5), (-3.0, 0.5)]
+            .iter()
+            .map(|&(x, y)| Vec2::new(x, y))
+            .collect();
+        let (tie, tolerance) = (0.001, 5e-4);
+        let (handle_a, handle_b) = (BodyHandle(0), BodyHandle(1));
+        // The box tilted so that one bottom corner is 0.003 into the slab and the other
+        // 0.007 above it.
+        let (poly_a, pose_a) = placed(&slab, Vec2::zeros(), 0.0);
+        let (poly_b, pose_b) = placed(&unit_square(), Vec2::new(0.0, 1.002), 0.01);
+        let wide = 0.02;
+        let first = collide_polygons((handle_a, &poly_a), (handle_b, &poly_b), wide, tie)
+            .expect("in contact");
+        assert_eq!(first.points().len(), 2);
+        // A refused pair leaves the cache until its fresh manifold is stored: each case
+        // starts from a cache holding the manifold found above.
+        let cache_of_first = || {
+            let mut cache = ManifoldCache::default();
+            cache.store(&first, (&pose_a, &pose_b), wide);
+            cache.begin_step();
+            cache
+        };
+        let wider =
+            cache_of_first().reuse((handle_a, &pose_a), (handle_b, &pose_b), 0.03, tolerance);
+        assert!(wider.is_none(), "a wider margin needs a fresh test");
+        let narrow = 0.005;
+        let reused = cache_of_first()
+            .reuse((handle_a, &pose_a), (handle_b, &pose_b), narrow, tolerance)
+            .expect("one point is still within the margin");
+        let fresh = collide_polygons((handle_a, &poly_a), (handle_b, &poly_b), narrow, tie)
+            .expect("in contact");
+        assert_eq!(reused.points().len(), 1);
+        assert_eq!(fresh.points().len(), 1);
+        assert_eq!(reused.points()[0].id, fresh.points()[0].id);
+        assert!((reused.points()[0].depth - fresh.points()[0].depth).abs() < 1e-12);
+    }
 }
