@@ -177,6 +177,10 @@ pub struct World {
     non_colliding: Vec<(u32, u32)>,
     /// Bodies with at least one joint, sorted.
     jointed: Vec<u32>,
+    /// The joints or ignored pairs changed since `non_colliding` and `jointed` were built:
+    /// they are rebuilt once at the next step, not at every change (a scene of 20,000 pins
+    /// took 12 s to build with a sort per `add_joint`).
+    collision_filter_stale: bool,
     /// Pairs kept apart by [`World::ignore_collisions`], besides the jointed ones.
     ignored_pairs: Vec<(u32, u32)>,
     body_motors: Vec<(BodyHandle, BodyMotor)>,
@@ -334,13 +338,13 @@ impl World {
             collide_connected: def.collide_connected,
             motor: def.motor,
         }));
-        self.rebuild_collision_filter();
+        self.collision_filter_stale = true;
         Ok(JointHandle((self.joints.len() - 1) as u32))
     }
 
     pub fn remove_joint(&mut self, handle: JointHandle) -> Option<Joint> {
         let removed = self.joints.get_mut(handle.index())?.take();
-        self.rebuild_collision_filter();
+        self.collision_filter_stale = true;
         removed
     }
 
@@ -348,8 +352,22 @@ impl World {
         self.joints.get(handle.index())?.as_ref()
     }
 
+    /// A joint to change; its bodies and `collide_connected` are read again at the next
+    /// step.
     pub fn joint_mut(&mut self, handle: JointHandle) -> Option<&mut Joint> {
-        self.joints.get_mut(handle.index())?.as_mut()
+        let joint = self.joints.get_mut(handle.index())?.as_mut()?;
+        self.collision_filter_stale = true;
+        Some(joint)
+    }
+
+    /// A joint's motor to change (switching it on and off, say) without the joint's
+    /// collision filter being rebuilt, as `joint_mut` has it.
+    pub fn joint_motor_mut(&mut self, handle: JointHandle) -> Option<&mut JointMotor> {
+        self.joints
+            .get_mut(handle.index())?
+            .as_mut()?
+            .motor
+            .as_mut()
     }
 
     /// Live joints in handle order.
@@ -398,27 +416,32 @@ impl World {
         &self.body_motors
     }
 
-    fn rebuild_collision_filter(&mut self) {
-        self.jointed = self
-            .joints
-            .iter()
-            .flatten()
-            .flat_map(|j| [Some(j.body_a.0), j.body_b.map(|b| b.0)])
-            .flatten()
-            .collect();
+    fn refresh_collision_filter(&mut self) {
+        if !std::mem::take(&mut self.collision_filter_stale) {
+            return;
+        }
+        self.jointed.clear();
+        self.jointed.extend(
+            self.joints
+                .iter()
+                .flatten()
+                .flat_map(|j| [Some(j.body_a.0), j.body_b.map(|b| b.0)])
+                .flatten(),
+        );
         self.jointed.sort_unstable();
         self.jointed.dedup();
-        self.non_colliding = self
-            .joints
-            .iter()
-            .flatten()
-            .filter(|j| !j.collide_connected)
-            .filter_map(|j| {
-                let (a, b) = (j.body_a.0, j.body_b?.0);
-                Some((a.min(b), a.max(b)))
-            })
-            .chain(self.ignored_pairs.iter().copied())
-            .collect();
+        self.non_colliding.clear();
+        self.non_colliding.extend(
+            self.joints
+                .iter()
+                .flatten()
+                .filter(|j| !j.collide_connected)
+                .filter_map(|j| {
+                    let (a, b) = (j.body_a.0, j.body_b?.0);
+                    Some((a.min(b), a.max(b)))
+                })
+                .chain(self.ignored_pairs.iter().copied()),
+        );
         self.non_colliding.sort_unstable();
         self.non_colliding.dedup();
     }
@@ -428,7 +451,7 @@ impl World {
     pub fn ignore_collisions(&mut self, a: BodyHandle, b: BodyHandle) {
         if a != b {
             self.ignored_pairs.push((a.0.min(b.0), a.0.max(b.0)));
-            self.rebuild_collision_filter();
+            self.collision_filter_stale = true;
         }
     }
 
@@ -507,6 +530,7 @@ impl World {
     }
 
     fn advance(&mut self, dt: f64) {
+        self.refresh_collision_filter();
         if self.settings.sleeping {
             self.wake_where_needed(dt);
         }

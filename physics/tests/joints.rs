@@ -366,3 +366,40 @@ fn a_joint_motor_reports_the_impulse_of_the_whole_step() {
         );
     }
 }
+
+/// The collision filter follows every change of the joints: `add_joint` and `joint_mut`
+/// (its `collide_connected`) and `remove_joint`, read at the next step.
+#[test]
+fn pinned_bodies_collide_exactly_when_their_joint_lets_them() {
+    let mut world = World::new(Vec2::new(0.0, 0.0));
+    let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let overlapping = [Vec2::new(0.0, 0.0), Vec2::new(0.5, 0.0)];
+    let [a, b] = overlapping.map(|at| {
+        world
+            .add_body(BodyDef::new(square.clone(), 1.0).at(at, 0.0))
+            .unwrap()
+    });
+    let touching = |world: &mut World| {
+        world.step(1.0 / 60.0);
+        world.manifolds().len()
+    };
+    assert_eq!(
+        touching(&mut world),
+        1,
+        "unjoined overlapping squares collide"
+    );
+    let pin = world
+        .add_joint(JointDef::new(a, Some(b), Vec2::new(0.25, 0.0)))
+        .unwrap();
+    assert_eq!(touching(&mut world), 0, "a pin keeps its bodies apart");
+    world.joint_mut(pin).unwrap().collide_connected = true;
+    assert_eq!(touching(&mut world), 1, "unless it lets them collide");
+    world.joint_mut(pin).unwrap().collide_connected = false;
+    assert_eq!(touching(&mut world), 0);
+    world.remove_joint(pin);
+    assert_eq!(
+        touching(&mut world),
+        1,
+        "a removed pin no longer keeps them apart"
+    );
+}

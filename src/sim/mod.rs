@@ -337,8 +337,7 @@ impl Simulation {
         let step = self.world.step_count();
         for j in &self.joints {
             if let Some((t0, t1, _)) = j.motor_window
-                && let Some(joint) = self.world.joint_mut(j.handle)
-                && let Some(m) = joint.motor.as_mut()
+                && let Some(m) = self.world.joint_motor_mut(j.handle)
             {
                 m.enabled = (t0..t1).contains(&step);
                 if !m.enabled {
