@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
-use crate::collide::{Aabb, Manifold, SweepAndPrune, WorldPolygon, collide_polygons};
+use crate::collide::{Aabb, BroadPhase, Manifold, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
@@ -211,12 +211,12 @@ struct Scratch {
     /// Islands of bodies, for sleeping and for `auto`'s choice of solver.
     island_union: UnionFind,
     wake_labels: Vec<u32>,
-    wake_broad_phase: SweepAndPrune,
+    wake_broad_phase: BroadPhase,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
     poses: Vec<Pose>,
     boxes: Vec<Option<Aabb>>,
-    broad_phase: SweepAndPrune,
+    broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
     solver_bodies: Vec<SolverBody>,
     /// How far each body can move this step.
@@ -760,7 +760,7 @@ impl World {
     }
 
     /// Wakes sleeping islands that an awake body can reach this step, and those with a
-    /// motor switching on. Candidates come from a sweep and prune over the bodies' bounding
+    /// motor switching on. Candidates come from the broad phase over the bodies' bounding
     /// circles (each awake one grown by its reach), so the cost follows the bodies near
     /// each other, not awake × asleep.
     fn wake_where_needed(&mut self, dt: f64) {

@@ -5,7 +5,7 @@ pub mod reuse;
 mod sat;
 pub mod toi;
 
-pub use broad::SweepAndPrune;
+pub use broad::BroadPhase;
 pub use sat::collide_polygons;
 
 use crate::body::{Body, BodyHandle};
