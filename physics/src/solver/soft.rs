@@ -183,6 +183,8 @@ pub struct SoftStepSolver {
     /// The memory of pins left out this step (both bodies fixed: asleep, or held under
     /// `auto`), kept so that they warm-start again when their bodies move.
     skipped_joint_memory: Vec<(u32, Vec2, f64)>,
+    /// `points` index ranges, one per island of contacts.
+    contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
     joint_islands: Vec<(usize, usize)>,
     island_uf: UnionFind,
@@ -272,7 +274,19 @@ impl SoftStepSolver {
         }));
         self.points.clear();
         self.memory.recall(contacts, &mut self.recalled);
-        for (i, c) in contacts.iter().enumerate() {
+        // The points are built island by island (each island's in the contacts' order):
+        // grouping the contacts is cheaper than reordering the larger points afterwards.
+        group_by_island(
+            contacts.len(),
+            bodies.len(),
+            |i| (contacts[i].body_a, contacts[i].body_b),
+            |i| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0,
+            &mut self.island_uf,
+            &mut self.grouped,
+        );
+        island_ranges(&self.grouped, &mut self.contact_islands);
+        for &(_, i) in &self.grouped {
+            let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
             let r_a = c.point - a.position;
             let r_b = c.point - b.position;
@@ -312,7 +326,8 @@ impl SoftStepSolver {
                 pair_coupling: None,
             });
         }
-        self.contact_lcp.prepare(&self.bodies, &mut self.points);
+        self.contact_lcp
+            .prepare(&self.bodies, &mut self.points, &self.contact_islands);
         for i in 1..self.points.len() {
             let (p, q) = (&self.points[i - 1], &self.points[i]);
             let same_manifold = p.a == q.a && p.b == q.b && p.normal == q.normal;
@@ -898,6 +913,11 @@ fn sort_into_islands<T: Copy>(
     spare.clear();
     spare.extend(grouped.iter().map(|&(_, i)| items[i as usize]));
     std::mem::swap(items, spare);
+    island_ranges(grouped, ranges);
+}
+
+/// The index range of each island in `grouped` (sorted by island).
+fn island_ranges(grouped: &[(u32, u32)], ranges: &mut Vec<(usize, usize)>) {
     ranges.clear();
     let mut start = 0;
     while start < grouped.len() {
@@ -1084,8 +1104,6 @@ struct ContactLcp {
     islands: Vec<(usize, usize, usize)>,
     /// Every contact island's point range, and whether it is solved as an LCP.
     all_islands: Vec<(usize, usize, bool)>,
-    ranges: Vec<(usize, usize)>,
-    spare_points: Vec<PointConstraint>,
     /// Row-major J M⁻¹ Jᵀ of each island: rows 2k (normal) and 2k + 1 (tangent) of point k.
     /// The anchors are fixed for the step, so it is built once per step.
     k: Vec<f64>,
@@ -1095,8 +1113,6 @@ struct ContactLcp {
     friction_index: Vec<Option<(usize, f64)>>,
     x: Vec<f64>,
     solver: LcpSolver,
-    uf: UnionFind,
-    grouped: Vec<(u32, u32)>,
 }
 
 /// A point's two rows: direction, and lever arms on A and B.
@@ -1106,30 +1122,29 @@ fn rows(p: &PointConstraint) -> [(Vec2, f64, f64); 2] {
 }
 
 impl ContactLcp {
-    /// Orders `points` island by island and builds the matrices of the small islands.
-    fn prepare(&mut self, bodies: &[SoftBody], points: &mut Vec<PointConstraint>) {
+    /// Builds the matrices of the small islands; `islands` are the points' index ranges.
+    fn prepare(
+        &mut self,
+        bodies: &[SoftBody],
+        points: &mut [PointConstraint],
+        islands: &[(usize, usize)],
+    ) {
         self.islands.clear();
         self.all_islands.clear();
         self.k.clear();
-        let mut ranges = std::mem::take(&mut self.ranges);
-        sort_into_islands(
-            (points, &mut self.spare_points),
-            |p| (p.a, p.b),
-            bodies,
-            (&mut self.uf, &mut self.grouped),
-            &mut ranges,
-        );
-        for &(start, end) in &ranges {
+        for &(start, end) in islands {
             let len = end - start;
-            let (lightest, heaviest) = points[start..end]
-                .iter()
-                .flat_map(|p| [p.a, p.b])
-                .map(|i| bodies[i as usize].inv_mass)
-                .filter(|&m| m > 0.0)
-                .fold((0.0, f64::INFINITY), |(most, least), m| {
-                    (f64::max(most, m), f64::min(least, m))
-                });
-            let lcp = len <= LCP_POINT_LIMIT && lightest >= LCP_MASS_RATIO * heaviest;
+            let lcp = len <= LCP_POINT_LIMIT && {
+                let (lightest, heaviest) = points[start..end]
+                    .iter()
+                    .flat_map(|p| [p.a, p.b])
+                    .map(|i| bodies[i as usize].inv_mass)
+                    .filter(|&m| m > 0.0)
+                    .fold((0.0, f64::INFINITY), |(most, least), m| {
+                        (f64::max(most, m), f64::min(least, m))
+                    });
+                lightest >= LCP_MASS_RATIO * heaviest
+            };
             self.all_islands.push((start, end, lcp));
             if lcp {
                 let offset = self.k.len();
@@ -1163,7 +1178,6 @@ impl ContactLcp {
                 self.islands.push((start, end, offset));
             }
         }
-        self.ranges = ranges;
     }
 
     /// One pass over the small islands: totals x with w = K (x − x₀) + v − target, normals
