@@ -101,9 +101,6 @@ struct PointConstraint {
     contact: u32,
     a: u32,
     b: u32,
-    /// Anchors relative to the centroids at the start of the step (world axes).
-    r_a: Vec2,
-    r_b: Vec2,
     normal: Vec2,
     /// The anchors' levers about the normal and the tangent (`r × n`, `r × t` on A and
     /// on B), fixed for the step like the anchors: a row's velocity and impulse use them
@@ -306,8 +303,6 @@ impl SoftStepSolver {
                 contact: i as u32,
                 a: c.body_a,
                 b: c.body_b,
-                r_a,
-                r_b,
                 normal: c.normal,
                 levers,
                 base_separation: -c.depth,
@@ -477,8 +472,10 @@ impl SoftStepSolver {
 
     fn warm_start(&mut self) {
         for p in &self.points {
-            let impulse = p.normal * p.normal_impulse + perp(p.normal) * p.tangent_impulse;
-            Self::apply(&mut self.bodies, p.a, p.b, p.r_a, p.r_b, impulse);
+            let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
+            pair.apply_along(p.normal, p.levers.normal, p.normal_impulse);
+            pair.apply_along(perp(p.normal), p.levers.tangent, p.tangent_impulse);
+            pair.store(&mut self.bodies);
         }
         for j in &self.joints {
             // A pin's impulse acts at its anchors where they are now: at the step's first
