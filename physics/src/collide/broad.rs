@@ -20,6 +20,7 @@ pub struct BroadPhase {
     /// the hash: `(hash, cell, body)`.
     sorted: Vec<(u32, (i64, i64), u32)>,
     bucket_starts: Vec<u32>,
+    spare_pairs: Vec<(u32, u32)>,
     large: Vec<u32>,
     is_large: Vec<bool>,
     extents: Vec<f64>,
@@ -41,7 +42,13 @@ impl BroadPhase {
         self.is_large.clear();
         self.is_large.resize(boxes.len(), false);
         let per_cell = 1.0 / self.cell_size(boxes);
-        let index = |v: f64| (v * per_cell).floor() as i64;
+        // floor(t) without a call to `floor` (the same for every finite t, and both map
+        // NaN to 0 and the infinities to the ends of i64).
+        let index = |v: f64| {
+            let t = v * per_cell;
+            let truncated = t as i64;
+            truncated - i64::from(t < truncated as f64)
+        };
         for (i, b) in boxes.iter().enumerate() {
             let Some(b) = b else {
                 continue;
@@ -108,7 +115,31 @@ impl BroadPhase {
                 }
             }
         }
-        out.sort_unstable();
+        self.sort_pairs(out, boxes.len());
+    }
+
+    /// Sorts `out` by a radix sort on its two body indices (`< bodies`): linear, where a
+    /// comparison sort was a quarter of the broad phase's time on a pile.
+    fn sort_pairs(&mut self, out: &mut Vec<(u32, u32)>, bodies: usize) {
+        for key in [|p: &(u32, u32)| p.1, |p: &(u32, u32)| p.0] {
+            let starts = &mut self.bucket_starts;
+            starts.clear();
+            starts.resize(bodies + 1, 0);
+            for p in out.iter() {
+                starts[key(p) as usize + 1] += 1;
+            }
+            for k in 1..starts.len() {
+                starts[k] += starts[k - 1];
+            }
+            self.spare_pairs.clear();
+            self.spare_pairs.resize(out.len(), (0, 0));
+            for p in out.iter() {
+                let at = &mut starts[key(p) as usize];
+                self.spare_pairs[*at as usize] = *p;
+                *at += 1;
+            }
+            std::mem::swap(out, &mut self.spare_pairs);
+        }
     }
 
     /// Groups `entries` into `sorted` by a hash of their cell, in linear time (a counting
