@@ -735,28 +735,30 @@ fn apply_normal(pair: &mut BodyPair, p: &mut PointConstraint, total: f64) {
     pair.apply_along(p.normal, p.levers.normal, delta);
 }
 
-/// The velocity a point's normal row aims at (minus bias) and its softness: speculative
-/// (closing the gap and no more), soft with bias, or rigid in the relax pass.
+/// A point's current separation: how its anchors moved along the normal since the start,
+/// with `a` and `b` its bodies. The impulse acts at the anchors fixed for the step (as
+/// warm starting applies it), so that every substep pushes through the same lever.
+#[inline(always)]
+fn separation(a: &SoftBody, b: &SoftBody, p: &PointConstraint) -> f64 {
+    // A body turned by q moves its anchor r by q·r − r, whose part along n is
+    // (cos − 1)(r·n) + sin (r × n): the anchor's reach along the normal and its lever.
+    let turned = |q: Rot, reach: f64, lever: f64| (q.cos - 1.0) * reach + q.sin * lever;
+    let (reach, lever) = (p.levers.reach, p.levers.normal);
+    (a.dp - b.dp).dot(&p.normal) + turned(a.dq, reach.0, lever.0) - turned(b.dq, reach.1, lever.1)
+        + p.base_separation
+}
+
+/// The velocity a point's normal row aims at (minus bias) and its softness, at
+/// `separation`: speculative (closing the gap and no more), soft with bias, or rigid in
+/// the relax pass.
 #[inline(always)]
 fn normal_target(
-    bodies: &[SoftBody],
-    p: &PointConstraint,
+    separation: f64,
     inv_h: f64,
     soft: &Softness,
     max_push: f64,
     use_bias: bool,
 ) -> (f64, (f64, f64), f64) {
-    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-    // Current separation: how the anchors moved along the normal since the start. The
-    // impulse acts at the anchors fixed for the step (as warm starting applies it), so
-    // that every substep pushes through the same lever.
-    // A body turned by q moves its anchor r by q·r − r, whose part along n is
-    // (cos − 1)(r·n) + sin (r × n): the anchor's reach along the normal and its lever.
-    let turned = |q: Rot, reach: f64, lever: f64| (q.cos - 1.0) * reach + q.sin * lever;
-    let (reach, lever) = (p.levers.reach, p.levers.normal);
-    let separation = (a.dp - b.dp).dot(&p.normal) + turned(a.dq, reach.0, lever.0)
-        - turned(b.dq, reach.1, lever.1)
-        + p.base_separation;
     if separation > 0.0 {
         (-separation * inv_h, (1.0, 0.0), separation)
     } else if use_bias {
@@ -770,6 +772,20 @@ fn normal_target(
     }
 }
 
+/// A point's normal target (see `normal_target`) from its bodies' motion.
+#[inline(always)]
+fn point_target(
+    bodies: &[SoftBody],
+    p: &PointConstraint,
+    inv_h: f64,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) -> (f64, (f64, f64), f64) {
+    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+    normal_target(separation(a, b, p), inv_h, soft, max_push, use_bias)
+}
+
 fn solve_point(
     bodies: &mut [SoftBody],
     p: &mut PointConstraint,
@@ -778,7 +794,7 @@ fn solve_point(
     max_push: f64,
     use_bias: bool,
 ) {
-    let (target, softness, separation) = normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+    let (target, softness, separation) = point_target(bodies, p, inv_h, soft, max_push, use_bias);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     solve_normal(&mut pair, p, target, softness, separation);
     solve_friction(&mut pair, p);
@@ -820,8 +836,10 @@ fn solve_pair(
     max_push: f64,
     use_bias: bool,
 ) {
-    let (tp, sp, dp) = normal_target(bodies, p, inv_h, soft, max_push, use_bias);
-    let (tq, sq, dq) = normal_target(bodies, q, inv_h, soft, max_push, use_bias);
+    // One manifold's two points share their bodies.
+    let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+    let (tp, sp, dp) = normal_target(separation(a, b, p), inv_h, soft, max_push, use_bias);
+    let (tq, sq, dq) = normal_target(separation(a, b, q), inv_h, soft, max_push, use_bias);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     if sp == sq {
         let (v1, v2) = (approach(&pair, p, dp), approach(&pair, q, dq));
@@ -1200,7 +1218,7 @@ impl ContactLcp {
             self.friction_index.clear();
             for (i, p) in island.iter_mut().enumerate() {
                 let (target, _, separation) =
-                    normal_target(bodies, p, inv_h, soft, max_push, use_bias);
+                    point_target(bodies, p, inv_h, soft, max_push, use_bias);
                 let pair = BodyPair::load(bodies, p.a, p.b);
                 let vn = approach(&pair, p, separation);
                 let vt = pair.velocity_along(perp(p.normal), p.levers.tangent);
