@@ -12,6 +12,9 @@ use super::Aabb;
 /// A body covering more cells than this is compared with every body directly.
 const MAX_CELLS: i64 = 16;
 
+/// Up to this many pairs are sorted by comparison, more by a radix sort.
+const SMALL_SORT: usize = 64;
+
 #[derive(Debug, Clone, Default)]
 pub struct BroadPhase {
     /// ((cell x, cell y), body) for every cell each listed body covers, in body order.
@@ -41,7 +44,11 @@ impl BroadPhase {
         self.large.clear();
         self.is_large.clear();
         self.is_large.resize(boxes.len(), false);
-        let per_cell = 1.0 / self.cell_size(boxes);
+        let cell = self.cell_size(boxes);
+        if self.extents.len() < 2 {
+            return; // no pair
+        }
+        let per_cell = 1.0 / cell;
         // floor(t) without a call to `floor` (the same for every finite t, and both map
         // NaN to 0 and the infinities to the ends of i64).
         let index = |v: f64| {
@@ -121,6 +128,10 @@ impl BroadPhase {
     /// Sorts `out` by a radix sort on its two body indices (`< bodies`): linear, where a
     /// comparison sort was a quarter of the broad phase's time on a pile.
     fn sort_pairs(&mut self, out: &mut Vec<(u32, u32)>, bodies: usize) {
+        if out.len() <= SMALL_SORT {
+            out.sort_unstable(); // a robot's few pairs: cheaper than two counting passes
+            return;
+        }
         for key in [|p: &(u32, u32)| p.1, |p: &(u32, u32)| p.0] {
             let starts = &mut self.bucket_starts;
             starts.clear();
