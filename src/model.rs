@@ -63,6 +63,19 @@ pub struct JointMotorDef {
     pub location: Location,
 }
 
+/// A placement `local` (x, y, orientation) given in a parent `frame` (x, y, orientation),
+/// in the frame's own parent: origin + R(angle)·local, the angles added. A robot's body in
+/// its scene, say.
+pub fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (f64, f64, f64) {
+    let (s, c) = frame.2.sin_cos();
+    let (x, y) = (local.0, local.1);
+    (
+        frame.0 + c * x - s * y,
+        frame.1 + s * x + c * y,
+        frame.2 + local.2,
+    )
+}
+
 /// A body placed in a robot's frame: `<body alias source x y orientation>`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Placement {

@@ -309,3 +309,44 @@ fn absurd_magnitudes_are_refused_by_check_and_by_the_simulation() {
         );
     }
 }
+
+#[test]
+fn a_robot_placed_so_far_that_its_bodies_pass_the_limits_is_refused_by_check_and_by_the_simulation()
+{
+    // Each placement is within ±1e9 as written; the robot's placement in the scene plus
+    // its body's in the robot is not.
+    let scene = "housenka on the floor";
+    let mut model = model();
+    let placed = &mut model
+        .scenes
+        .iter_mut()
+        .find(|s| s.name == scene)
+        .unwrap()
+        .robots[0];
+    placed.x = 9.5e8;
+    let source = placed.source.clone();
+    let robot = model.robots.iter_mut().find(|r| r.name == source).unwrap();
+    robot.bodies[0].placement.x = 1e8;
+    let alias = robot.bodies[0].placement.alias.clone();
+    let problems = robosim::db::check(&model, |k| format!("{k:?}.xml"));
+    let found = problems.iter().map(|p| p.to_string()).find(|p| {
+        p.contains(&format!("body \"{alias}\""))
+            && p.contains("placed in the scene")
+            && p.contains("beyond")
+    });
+    assert!(found.is_some(), "no problem reported in {problems:#?}");
+    let pins = problems
+        .iter()
+        .filter(|p| p.to_string().contains("the pin of"))
+        .count();
+    assert!(
+        pins > 0,
+        "the pins at that body are beyond too: {problems:#?}"
+    );
+    let refused = Simulation::new(&model, scene, None, None);
+    let message = refused.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        message.contains("beyond"),
+        "the simulation said {message:?}"
+    );
+}

@@ -3,7 +3,7 @@
 
 use super::problem::Problem;
 use super::{FileKind, clip};
-use crate::model::{BodyDef, Model, Robot, Scene};
+use crate::model::{BodyDef, Model, Robot, Scene, SceneRobot, compose};
 use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
 
@@ -12,9 +12,8 @@ use std::collections::BTreeMap;
 pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
 
 /// The largest magnitude each kind of number may have: the engine's own, so that what
-/// passes here is what `pe` accepts (each placement is checked as written; a world
-/// position that only the sum of a robot's and its body's placement puts beyond the limit
-/// is refused by `pe` when the scene is built).
+/// passes here is what `pe` accepts (each placement as written, and a robot's bodies and
+/// pins where its placement in a scene puts them).
 pub use pe::limits;
 
 /// "`what` {value} is larger than {limit}" when `value` exceeds `limit` in magnitude.
@@ -335,7 +334,11 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
         ]) {
             out.push(Problem::error(file, &what, message).at(r.location));
         }
-        if model.robot(&r.source).is_none() {
+        if let Some(robot) = model.robot(&r.source) {
+            for message in placed_robot_beyond(robot, r) {
+                out.push(Problem::error(file, &what, message).at(r.location));
+            }
+        } else {
             out.push(
                 Problem::error(
                     file,
@@ -380,4 +383,60 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             );
         }
     }
+}
+
+/// Where robot `robot`, placed in a scene by `placed`, puts its bodies and pins beyond the
+/// engine's limits, though each placement is within them as written (those are reported
+/// where they are written).
+fn placed_robot_beyond(robot: &Robot, placed: &SceneRobot) -> Vec<String> {
+    let frame = (placed.x, placed.y, placed.orientation);
+    let within = |(x, y, angle): (f64, f64, f64)| {
+        beyond_all(&[
+            ("x", x, limits::COORDINATE),
+            ("y", y, limits::COORDINATE),
+            ("orientation", angle, limits::ANGLE),
+        ])
+        .is_empty()
+    };
+    if !within(frame) {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for b in &robot.bodies {
+        let p = &b.placement;
+        if !within((p.x, p.y, p.orientation)) {
+            continue;
+        }
+        let (x, y, angle) = compose(frame, (p.x, p.y, p.orientation));
+        for message in beyond_all(&[
+            ("x", x, limits::COORDINATE),
+            ("y", y, limits::COORDINATE),
+            ("orientation", angle, limits::ANGLE),
+        ]) {
+            out.push(format!(
+                "body \"{}\" of robot \"{}\", placed in the scene: {message}",
+                clip(&p.alias),
+                clip(&robot.name)
+            ));
+        }
+    }
+    for j in &robot.joints {
+        let Some(a) = robot.body(&j.body_a) else {
+            continue;
+        };
+        let [px, py] = j.point(&a.placement);
+        if !within((px, py, 0.0)) {
+            continue;
+        }
+        let (x, y, _) = compose(frame, (px, py, 0.0));
+        for message in beyond_all(&[("x", x, limits::COORDINATE), ("y", y, limits::COORDINATE)]) {
+            out.push(format!(
+                "the pin of \"{}\" and \"{}\" (robot \"{}\"), placed in the scene: {message}",
+                clip(&j.body_a),
+                clip(&j.body_b),
+                clip(&robot.name)
+            ));
+        }
+    }
+    out
 }

@@ -79,14 +79,10 @@ pub struct Simulation {
     solver: ContactSolver,
 }
 
-/// A placement composed with a parent frame: world = origin + R(angle)·local; angles add.
+/// A placement composed with a parent frame (`model::compose`), as a position and angle.
 fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (Vec2, f64) {
-    let (s, c) = frame.2.sin_cos();
-    let (x, y) = (local.0, local.1);
-    (
-        Vec2::new(frame.0 + c * x - s * y, frame.1 + s * x + c * y),
-        frame.2 + local.2,
-    )
+    let (x, y, angle) = crate::model::compose(frame, local);
+    (Vec2::new(x, y), angle)
 }
 
 fn placement_frame(p: &Placement) -> (f64, f64, f64) {
