@@ -1,11 +1,13 @@
 //! Broad phase: a uniform grid of cells about twice the size of a typical body.
 //!
-//! Each body is listed in the cells its bounds cover, the list is sorted by cell, and
-//! only bodies sharing a cell are compared: linear in the number of bodies for piles,
-//! grids and blocks alike. (A sweep and prune along x, its predecessor, compared every
-//! body with every other in the same column: a million pairs per step for a 100 × 100
-//! grid.) A body covering more than `MAX_CELLS` cells (a floor, a wall) is compared with
-//! every body instead of being listed.
+//! Each body is listed in the cells its bounds cover, the list is grouped by cell (a
+//! counting sort on a hash of the cell), and only bodies sharing a cell are compared:
+//! linear in the number of bodies for piles, grids and blocks alike. (A sweep and prune
+//! along x, its predecessor, compared every body with every other in the same column: a
+//! million pairs per step for a 100 × 100 grid.) A body covering more than `MAX_CELLS`
+//! cells (a floor, a wall) is compared with every body instead of being listed: cheap
+//! while such bodies are few, as they are in a scene of bodies on terrain. Deterministic:
+//! the pairs come out sorted, whatever the order they were found in.
 
 use super::Aabb;
 
@@ -220,6 +222,16 @@ mod tests {
         })
     }
 
+    /// A deterministic stream of numbers in [0, 1) (xorshift).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     fn brute(boxes: &[Option<Aabb>]) -> Vec<(u32, u32)> {
         let mut v = vec![];
         for i in 0..boxes.len() {
@@ -236,16 +248,10 @@ mod tests {
 
     #[test]
     fn finds_exactly_the_overlapping_pairs_as_boxes_move() {
-        let mut sap = BroadPhase::default();
+        let mut broad = BroadPhase::default();
         let mut out = vec![];
         // A deterministic cloud of boxes, moved a little each round.
-        let mut seed = 12345u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(12345);
         let mut centres: Vec<(f64, f64)> = (0..200).map(|_| (rnd() * 50.0, rnd() * 50.0)).collect();
         for round in 0..20 {
             let boxes: Vec<Option<Aabb>> = centres
@@ -259,7 +265,7 @@ mod tests {
                     }
                 })
                 .collect();
-            sap.pairs(&boxes, |_, _| true, &mut out);
+            broad.pairs(&boxes, |_, _| true, &mut out);
             assert_eq!(out, brute(&boxes), "round {round}");
             for c in &mut centres {
                 c.0 += rnd() - 0.5;
@@ -274,13 +280,7 @@ mod tests {
     fn finds_exactly_the_overlapping_pairs_of_mixed_sizes() {
         let mut broad = BroadPhase::default();
         let mut out = vec![];
-        let mut seed = 987654321u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(987654321);
         for (round, offset) in [0.0, -37.3, 1e9].into_iter().enumerate() {
             let boxes: Vec<Option<Aabb>> = (0..300)
                 .map(|i| {
@@ -308,14 +308,14 @@ mod tests {
 
     #[test]
     fn filter_drops_pairs() {
-        let mut sap = BroadPhase::default();
+        let mut broad = BroadPhase::default();
         let mut out = vec![];
         let boxes = [
             aabb(0., 0., 1., 1.),
             aabb(0.5, 0.5, 2., 2.),
             aabb(0.9, 0.9, 3., 3.),
         ];
-        sap.pairs(&boxes, |i, j| (i, j) != (0, 1), &mut out);
+        broad.pairs(&boxes, |i, j| (i, j) != (0, 1), &mut out);
         assert_eq!(out, vec![(0, 2), (1, 2)]);
     }
 }
