@@ -6,8 +6,9 @@
 //! along x, its predecessor, compared every body with every other in the same column: a
 //! million pairs per step for a 100 × 100 grid.) A body covering more than `MAX_CELLS`
 //! cells (a floor, a wall) is compared with every body instead of being listed: cheap
-//! while such bodies are few, as they are in a scene of bodies on terrain. Deterministic:
-//! the pairs come out sorted, whatever the order they were found in.
+//! while such bodies are few, as they are in a scene of bodies on terrain. A scene of a
+//! few bodies (a robot) skips the grid and compares every pair. Deterministic: the pairs
+//! come out sorted, whatever the order they were found in.
 
 use super::Aabb;
 
@@ -16,6 +17,10 @@ const MAX_CELLS: i64 = 16;
 
 /// Up to this many pairs are sorted by comparison, more by a radix sort.
 const SMALL_SORT: usize = 64;
+
+/// Up to this many bodies are compared pair by pair, without the grid: for a robot's
+/// dozen bodies the grid's bookkeeping cost four times the comparisons.
+const ALL_PAIRS_LIMIT: usize = 24;
 
 #[derive(Debug, Clone, Default)]
 pub struct BroadPhase {
@@ -26,6 +31,7 @@ pub struct BroadPhase {
     sorted: Vec<(u32, (i64, i64), u32)>,
     bucket_starts: Vec<u32>,
     spare_pairs: Vec<(u32, u32)>,
+    present: Vec<u32>,
     large: Vec<u32>,
     is_large: Vec<bool>,
     extents: Vec<f64>,
@@ -46,11 +52,23 @@ impl BroadPhase {
         self.large.clear();
         self.is_large.clear();
         self.is_large.resize(boxes.len(), false);
-        let cell = self.cell_size(boxes);
-        if self.extents.len() < 2 {
-            return; // no pair
+        self.present.clear();
+        self.present
+            .extend((0..boxes.len() as u32).filter(|&i| boxes[i as usize].is_some()));
+        if self.present.len() <= ALL_PAIRS_LIMIT {
+            // A robot's few bodies: every pair, found in sorted order.
+            for (k, &i) in self.present.iter().enumerate() {
+                let bi = boxes[i as usize].expect("present");
+                for &j in &self.present[k + 1..] {
+                    let bj = boxes[j as usize].expect("present");
+                    if bi.overlaps(&bj) && wanted(i as usize, j as usize) {
+                        out.push((i, j));
+                    }
+                }
+            }
+            return;
         }
-        let per_cell = 1.0 / cell;
+        let per_cell = 1.0 / self.cell_size(boxes);
         // floor(t) without a call to `floor` (the same for every finite t, and both map
         // NaN to 0 and the infinities to the ends of i64).
         let index = |v: f64| {
@@ -187,7 +205,7 @@ impl BroadPhase {
     }
 
     /// Twice the median extent of the present boxes (1 when that is not a positive
-    /// number: no boxes, or all of them points).
+    /// number: all of them points).
     fn cell_size(&mut self, boxes: &[Option<Aabb>]) -> f64 {
         self.extents.clear();
         self.extents.extend(
@@ -299,9 +317,13 @@ mod tests {
             assert!(expected.len() > 250, "round {round}: a crowded scene");
             assert_eq!(out, expected, "round {round}");
         }
-        let points = vec![aabb(1.0, 1.0, 1.0, 1.0); 3];
-        broad.pairs(&points, |_, _| true, &mut out);
-        assert_eq!(out, vec![(0, 1), (0, 2), (1, 2)], "points alone");
+        for count in [3, 30] {
+            // Both ways of pairing (all pairs; the grid, whose cell size falls back to 1).
+            let points = vec![aabb(1.0, 1.0, 1.0, 1.0); count];
+            broad.pairs(&points, |_, _| true, &mut out);
+            assert_eq!(out.len(), count * (count - 1) / 2, "{count} points alone");
+            assert_eq!(out, brute(&points));
+        }
         broad.pairs(&[], |_, _| true, &mut out);
         assert!(out.is_empty());
     }
