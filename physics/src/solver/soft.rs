@@ -854,15 +854,21 @@ fn solve_pair(
 }
 
 /// The 2 × 2 normal block as a small LCP, solved by trying its four active sets: find
-/// totals x ≥ 0 with w = m_s (v_n − target) + K (x − x₀) + s D x₀ ≥ 0 and x·w = 0 (m_s, s
-/// the softness scales, x₀ the accumulated impulses, D the diagonal of K; rigid rows have
+/// totals x ≥ 0 with w = m_s (v_n − target) + K (x − x₀) + s S x₀ ≥ 0 and x·w = 0 (m_s, s
+/// the softness scales, x₀ the accumulated impulses, S the springs below; rigid rows have
 /// m_s = 1, s = 0).
 ///
-/// Each row keeps the spring of a point solved alone (its own effective mass, D); only the
-/// rows' coupling through the bodies' velocities (K) is solved together. With the springs
-/// coupled as well (K for D), a face resting on two points sagged half as deep again: the
-/// 20-, 40- and 100-row pyramids sank 0.048, 0.19 and 1.15 boxes instead of 0.033, 0.12
-/// and 0.88 (Box2D v3, point by point: 0.03, 0.12 and 0.91).
+/// The springs: a point solved alone is a spring scaled by its own effective mass 1/k_ii,
+/// and the face's sinking mode (both points together) is then as stiff as k₁₁ + k₁₂
+/// against k₁₁ coupled (S = K, every mode at the contact's frequency) — stiffer where
+/// k₁₂ > 0 (a box resting across two below it, whose points lie on one side of each
+/// centroid) and softer where k₁₂ < 0 (a face resting on its two corners, the points'
+/// rows pulling against each other through the bodies' rotation). So S keeps the stiffer:
+/// one spring per point (S = diag K) where k₁₂ ≥ 0, coupled springs (S = K) where k₁₂ < 0.
+/// Coupled everywhere, the 20-, 40- and 100-row pyramids sank 0.048, 0.19 and 1.15 boxes;
+/// one per point everywhere, the stacks of 10 and 20 sank 0.035 and 0.14 instead of
+/// 0.028 and 0.11. As now: pyramids 0.032, 0.12 and 0.88 (Box2D v3, point by point:
+/// 0.03, 0.12 and 0.91), stacks 0.028 and 0.11 (Box2D v3 0.034; rapier2d 0.032, 0.135).
 #[inline(always)]
 fn solve_normal_pair(
     pair: &mut BodyPair,
@@ -873,11 +879,14 @@ fn solve_normal_pair(
 ) {
     let block = p.pair_coupling.expect("paired points");
     let (x1, x2) = (p.normal_impulse, q.normal_impulse);
-    // w = K x + r with r = m_s (v − target) − K x₀ + s D x₀; the one-row cases are
+    // w = K x + r with r = m_s (v − target) − K x₀ + s S x₀; the one-row cases are
     // x₁ = −r₁ / k₁₁ (with normal_mass = 1 / k₁₁).
     let (k11, k12, k22) = (block.k11, block.k12, block.k22);
-    let r1 = mass_scale * (v1 - tp) - (k11 * x1 + k12 * x2) + impulse_scale * k11 * x1;
-    let r2 = mass_scale * (v2 - tq) - (k12 * x1 + k22 * x2) + impulse_scale * k22 * x2;
+    let spring12 = k12.min(0.0);
+    let r1 =
+        mass_scale * (v1 - tp) - (k11 * x1 + k12 * x2) + impulse_scale * (k11 * x1 + spring12 * x2);
+    let r2 =
+        mass_scale * (v2 - tq) - (k12 * x1 + k22 * x2) + impulse_scale * (spring12 * x1 + k22 * x2);
     let (i11, i12, i22) = block.inverse;
     let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
     let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
