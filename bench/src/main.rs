@@ -1,8 +1,9 @@
 //! Times `pe` (contact solvers `exact`, `soft` and `auto`) against rapier2d and Box2D v3 on
 //! scenes with known answers, and writes the results as Markdown to docs/bench/results.md;
-//! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots.
+//! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots; with
+//! `pe <scene> [solver]`, one scene in pe alone (for profiling), printing its outcome.
 //!
-//! Run with `cargo run --release [-- sweep]` inside bench/.
+//! Run with `cargo run --release [-- sweep | -- pe smash soft]` inside bench/.
 
 mod box2d_scenes;
 mod harness;
@@ -109,6 +110,10 @@ fn main() {
         write_doc(docs, "sweep.md", &md);
         return;
     }
+    if std::env::args().nth(1).as_deref() == Some("pe") {
+        run_pe_alone();
+        return;
+    }
     let mut rows = Vec::new();
     for spec in &PYRAMIDS {
         rows.push(run_row(
@@ -160,6 +165,31 @@ fn main() {
     let robot_rows = robots::run();
     let report = report(&rows, &narrow, &robot_rows, started.elapsed(), &load);
     write_doc(docs, "results.md", &report);
+}
+
+/// `pe <scene> [solver]`: one pile, grid or smash scene in pe alone, so that a profiler
+/// sees only pe's step.
+fn run_pe_alone() {
+    let scene = std::env::args().nth(2).unwrap_or_default();
+    let solver_name = std::env::args().nth(3).unwrap_or_else(|| "soft".into());
+    let Some(solver) = ContactSolver::from_name(&solver_name) else {
+        eprintln!("unknown solver {solver_name:?}");
+        std::process::exit(2);
+    };
+    let config = PeConfig::new(solver);
+    let outcome = if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
+        pe_scenes::pyramid(config, spec, H)
+    } else if scene == joint_grid::NAME {
+        pe_scenes::joint_grid(config)
+    } else if scene == smash::NAME {
+        pe_scenes::smash(config)
+    } else {
+        let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
+        names.extend([joint_grid::NAME, smash::NAME]);
+        eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
+        std::process::exit(2);
+    };
+    println!("{scene} under pe {}: {outcome:?}", solver.name());
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.

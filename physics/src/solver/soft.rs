@@ -14,7 +14,11 @@ use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
+use batch::{PassItem, PassPlan, PassSettings};
 use nalgebra::{DMatrix, DVector};
+
+mod batch;
+mod f64x4;
 
 /// Joint islands up to this many pins are solved as one linear system per pass (a dense
 /// Cholesky of 2m × 2m); larger ones pin by pin. One pass of pin-by-pin Gauss–Seidel
@@ -136,6 +140,27 @@ struct NormalBlock {
     inverse: (f64, f64, f64),
 }
 
+impl NormalBlock {
+    /// The block of two points `p`, `q` of one manifold between bodies `a` and `b`, if it
+    /// is well conditioned.
+    fn of(
+        (a, b): (&SoftBody, &SoftBody),
+        (p, q): (&PointConstraint, &PointConstraint),
+    ) -> Option<Self> {
+        let ((a1, b1), (a2, b2)) = (p.levers.normal, q.levers.normal);
+        let k12 = a.inv_mass + b.inv_mass + a.inv_inertia * a1 * a2 + b.inv_inertia * b1 * b2;
+        let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
+        let det = k11 * k22 - k12 * k12;
+        (p.normal_mass > 0.0 && q.normal_mass > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det)
+            .then_some(Self {
+                k11,
+                k12,
+                k22,
+                inverse: (k22 / det, -k12 / det, k11 / det),
+            })
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct PointLevers {
     normal: (f64, f64),
@@ -188,6 +213,8 @@ pub struct SoftStepSolver {
     grouped: Vec<(u32, u32)>,
     block: JointBlock,
     contact_lcp: ContactLcp,
+    /// The passes' order over the manifolds outside the LCP islands.
+    plan: PassPlan,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
 }
@@ -246,6 +273,9 @@ impl SoftStepSolver {
             for j in &mut self.joints {
                 j.motor_step_total += j.motor_impulse;
             }
+        }
+        for batch in &self.plan.batches {
+            batch.scatter(&mut self.points);
         }
         self.restitution(bounce_below);
         self.store(bodies, contacts, joints);
@@ -330,20 +360,14 @@ impl SoftStepSolver {
             if !same_manifold || taken {
                 continue;
             }
-            let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-            let ((a1, b1), (a2, b2)) = (p.levers.normal, q.levers.normal);
-            let k12 = a.inv_mass + b.inv_mass + a.inv_inertia * a1 * a2 + b.inv_inertia * b1 * b2;
-            let (k11, k22) = (1.0 / p.normal_mass, 1.0 / q.normal_mass);
-            let det = k11 * k22 - k12 * k12;
-            if p.normal_mass > 0.0 && q.normal_mass > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det {
-                self.points[i - 1].pair_coupling = Some(NormalBlock {
-                    k11,
-                    k12,
-                    k22,
-                    inverse: (k22 / det, -k12 / det, k11 / det),
-                });
-            }
+            let block = NormalBlock::of(
+                (&self.bodies[p.a as usize], &self.bodies[p.b as usize]),
+                (p, q),
+            );
+            self.points[i - 1].pair_coupling = block;
         }
+        self.plan
+            .plan(&self.contact_islands, &self.points, &self.bodies);
         self.joints.clear();
         self.skipped_joint_memory.clear();
         for (input, j) in joints.iter().enumerate() {
@@ -471,11 +495,20 @@ impl SoftStepSolver {
     }
 
     fn warm_start(&mut self) {
-        for p in &self.points {
-            let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
-            pair.apply_along(p.normal, p.levers.normal, p.normal_impulse);
-            pair.apply_along(perp(p.normal), p.levers.tangent, p.tangent_impulse);
-            pair.store(&mut self.bodies);
+        for p in self.points.iter().filter(|p| p.in_lcp) {
+            warm_start_point(&mut self.bodies, p);
+        }
+        let PassPlan { items, batches, .. } = &self.plan;
+        for item in items {
+            match *item {
+                PassItem::Batch(k) => batches[k as usize].warm_start(&mut self.bodies),
+                PassItem::Manifold(first, count) => {
+                    let (first, count) = (first as usize, count as usize);
+                    for p in &self.points[first..first + count] {
+                        warm_start_point(&mut self.bodies, p);
+                    }
+                }
+            }
         }
         for j in &self.joints {
             // A pin's impulse acts at its anchors where they are now: at the step's first
@@ -517,45 +550,28 @@ impl SoftStepSolver {
                 }
             }
         }
-        self.contact_lcp.solve(
-            &mut self.bodies,
-            &mut self.points,
+        let pass = PassSettings {
             inv_h,
-            contact_soft,
+            soft: *contact_soft,
             max_push,
             use_bias,
-        );
-        // In the points' order (by island, then by body pair) on purpose. Ordering by
-        // colours of the constraint graph, as Box2D v3 does to solve a colour's manifolds
-        // side by side, made the 100-row pyramid fall (421 of 5,050 boxes moved over half a
-        // box in 500 steps, against none): within one colour no two manifolds share a body,
-        // so a Gauss–Seidel pass carries the load only as many layers as there are colours,
-        // while the pair order, bottom row first, carries it through the whole pile.
-        let mut i = 0;
-        while i < self.points.len() {
-            if self.points[i].in_lcp {
-                i += 1;
-            } else if self.points[i].pair_coupling.is_some() {
-                let (first, second) = self.points.split_at_mut(i + 1);
-                solve_pair(
-                    &mut self.bodies,
-                    (&mut first[i], &mut second[0]),
-                    inv_h,
-                    contact_soft,
-                    max_push,
-                    use_bias,
-                );
-                i += 2;
-            } else {
-                solve_point(
-                    &mut self.bodies,
-                    &mut self.points[i],
-                    inv_h,
-                    contact_soft,
-                    max_push,
-                    use_bias,
-                );
-                i += 1;
+        };
+        self.contact_lcp
+            .solve(&mut self.bodies, &mut self.points, &pass);
+        // In the plan's order: big islands colour by colour, four manifolds at a time
+        // (see `batch`), small ones in the points' order.
+        let PassPlan { items, batches, .. } = &mut self.plan;
+        for item in items.iter() {
+            match *item {
+                PassItem::Batch(k) => batches[k as usize].solve(&mut self.bodies, &pass),
+                PassItem::Manifold(first, 2) => {
+                    let i = first as usize;
+                    let (first, second) = self.points.split_at_mut(i + 1);
+                    solve_pair(&mut self.bodies, (&mut first[i], &mut second[0]), &pass);
+                }
+                PassItem::Manifold(first, _) => {
+                    solve_point(&mut self.bodies, &mut self.points[first as usize], &pass)
+                }
             }
         }
     }
@@ -633,6 +649,14 @@ impl SoftStepSolver {
             .extend_from_slice(&self.skipped_joint_memory);
         self.joint_memory.sort_unstable_by_key(|x| x.0);
     }
+}
+
+/// Re-applies a point's accumulated impulses at the start of a substep.
+fn warm_start_point(bodies: &mut [SoftBody], p: &PointConstraint) {
+    let mut pair = BodyPair::load(bodies, p.a, p.b);
+    pair.apply_along(p.normal, p.levers.normal, p.normal_impulse);
+    pair.apply_along(perp(p.normal), p.levers.tangent, p.tangent_impulse);
+    pair.store(bodies);
 }
 
 /// A contact point's normal velocity at its fixed anchors (A relative to B).
@@ -752,18 +776,13 @@ fn separation(a: &SoftBody, b: &SoftBody, p: &PointConstraint) -> f64 {
 /// `separation`: speculative (closing the gap and no more), soft with bias, or rigid in
 /// the relax pass.
 #[inline(always)]
-fn normal_target(
-    separation: f64,
-    inv_h: f64,
-    soft: &Softness,
-    max_push: f64,
-    use_bias: bool,
-) -> (f64, (f64, f64), f64) {
+fn normal_target(separation: f64, pass: &PassSettings) -> (f64, (f64, f64), f64) {
+    let soft = &pass.soft;
     if separation > 0.0 {
-        (-separation * inv_h, (1.0, 0.0), separation)
-    } else if use_bias {
+        (-separation * pass.inv_h, (1.0, 0.0), separation)
+    } else if pass.use_bias {
         (
-            -(soft.bias_rate * separation).max(-max_push),
+            -(soft.bias_rate * separation).max(-pass.max_push),
             (soft.mass_scale, soft.impulse_scale),
             separation,
         )
@@ -777,24 +796,14 @@ fn normal_target(
 fn point_target(
     bodies: &[SoftBody],
     p: &PointConstraint,
-    inv_h: f64,
-    soft: &Softness,
-    max_push: f64,
-    use_bias: bool,
+    pass: &PassSettings,
 ) -> (f64, (f64, f64), f64) {
     let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-    normal_target(separation(a, b, p), inv_h, soft, max_push, use_bias)
+    normal_target(separation(a, b, p), pass)
 }
 
-fn solve_point(
-    bodies: &mut [SoftBody],
-    p: &mut PointConstraint,
-    inv_h: f64,
-    soft: &Softness,
-    max_push: f64,
-    use_bias: bool,
-) {
-    let (target, softness, separation) = point_target(bodies, p, inv_h, soft, max_push, use_bias);
+fn solve_point(bodies: &mut [SoftBody], p: &mut PointConstraint, pass: &PassSettings) {
+    let (target, softness, separation) = point_target(bodies, p, pass);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     solve_normal(&mut pair, p, target, softness, separation);
     solve_friction(&mut pair, p);
@@ -831,15 +840,12 @@ fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
 fn solve_pair(
     bodies: &mut [SoftBody],
     (p, q): (&mut PointConstraint, &mut PointConstraint),
-    inv_h: f64,
-    soft: &Softness,
-    max_push: f64,
-    use_bias: bool,
+    pass: &PassSettings,
 ) {
     // One manifold's two points share their bodies.
     let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-    let (tp, sp, dp) = normal_target(separation(a, b, p), inv_h, soft, max_push, use_bias);
-    let (tq, sq, dq) = normal_target(separation(a, b, q), inv_h, soft, max_push, use_bias);
+    let (tp, sp, dp) = normal_target(separation(a, b, p), pass);
+    let (tq, sq, dq) = normal_target(separation(a, b, q), pass);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     if sp == sq {
         let (v1, v2) = (approach(&pair, p, dp), approach(&pair, q, dq));
@@ -1217,10 +1223,7 @@ impl ContactLcp {
         &mut self,
         bodies: &mut [SoftBody],
         points: &mut [PointConstraint],
-        inv_h: f64,
-        soft: &Softness,
-        max_push: f64,
-        use_bias: bool,
+        pass: &PassSettings,
     ) {
         for &(start, end, offset) in &self.islands {
             let island = &mut points[start..end];
@@ -1232,8 +1235,7 @@ impl ContactLcp {
             self.hi.clear();
             self.friction_index.clear();
             for (i, p) in island.iter_mut().enumerate() {
-                let (target, _, separation) =
-                    point_target(bodies, p, inv_h, soft, max_push, use_bias);
+                let (target, _, separation) = point_target(bodies, p, pass);
                 let pair = BodyPair::load(bodies, p.a, p.b);
                 let vn = approach(&pair, p, separation);
                 let vt = pair.velocity_along(perp(p.normal), p.levers.tangent);
@@ -1260,7 +1262,7 @@ impl ContactLcp {
             let stats = self.solver.solve(&problem, &mut self.x);
             if stats.method == LcpMethod::Rejected {
                 for p in island.iter_mut() {
-                    solve_point(bodies, p, inv_h, soft, max_push, use_bias);
+                    solve_point(bodies, p, pass);
                 }
                 continue;
             }
