@@ -274,7 +274,7 @@ impl SoftStepSolver {
                 j.motor_step_total += j.motor_impulse;
             }
         }
-        for batch in &self.plan.batches {
+        for batch in self.plan.batches() {
             batch.scatter(&mut self.points);
         }
         self.restitution(bounce_below);
@@ -498,8 +498,8 @@ impl SoftStepSolver {
         for p in self.points.iter().filter(|p| p.in_lcp) {
             warm_start_point(&mut self.bodies, p);
         }
-        let PassPlan { items, batches, .. } = &self.plan;
-        for item in items {
+        let batches = self.plan.batches();
+        for item in &self.plan.items {
             match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start(&mut self.bodies),
                 PassItem::Manifold(first, count) => {
@@ -560,8 +560,8 @@ impl SoftStepSolver {
             .solve(&mut self.bodies, &mut self.points, &pass);
         // In the plan's order: big islands colour by colour, four manifolds at a time
         // (see `batch`), small ones in the points' order.
-        let PassPlan { items, batches, .. } = &mut self.plan;
-        for item in items.iter() {
+        let (items, batches) = self.plan.work();
+        for item in items {
             match *item {
                 PassItem::Batch(k) => batches[k as usize].solve(&mut self.bodies, &pass),
                 PassItem::Manifold(first, 2) => {

@@ -47,7 +47,9 @@ pub(super) enum PassItem {
 #[derive(Debug, Clone, Default)]
 pub(super) struct PassPlan {
     pub items: Vec<PassItem>,
-    pub batches: Vec<ManifoldBatch>,
+    /// The step's batches are the first `batch_count`; the rest are kept to be refilled.
+    batches: Vec<ManifoldBatch>,
+    batch_count: usize,
     /// Per body, a bit for each colour it already has a manifold in.
     colours_of: Vec<u32>,
     /// `(colour, first point, point count)` of the coloured manifolds.
@@ -64,7 +66,7 @@ impl PassPlan {
         bodies: &[SoftBody],
     ) {
         self.items.clear();
-        self.batches.clear();
+        self.batch_count = 0;
         self.coloured.clear();
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
@@ -91,7 +93,8 @@ impl PassPlan {
         }
         // A stable sort: each colour keeps the points' order.
         self.coloured.sort_by_key(|c| c.0);
-        let mut lanes = Vec::with_capacity(LANES);
+        let mut lanes = [0; LANES];
+        let mut filled = 0;
         let mut i = 0;
         while i < self.coloured.len() {
             let colour = self.coloured[i].0;
@@ -103,18 +106,36 @@ impl PassPlan {
                     self.items.push(PassItem::Manifold(first, count));
                     continue;
                 }
-                lanes.push(first);
-                if lanes.len() == LANES {
-                    self.items.push(PassItem::Batch(self.batches.len() as u32));
-                    let firsts = [lanes[0], lanes[1], lanes[2], lanes[3]];
-                    self.batches
-                        .push(ManifoldBatch::gather(firsts, points, bodies));
-                    lanes.clear();
+                lanes[filled] = first;
+                filled += 1;
+                if filled == LANES {
+                    self.add_batch(lanes, points, bodies);
+                    filled = 0;
                 }
             }
-            self.items
-                .extend(lanes.drain(..).map(|f| PassItem::Manifold(f, 2)));
+            let rest = lanes[..filled].iter().map(|&f| PassItem::Manifold(f, 2));
+            self.items.extend(rest);
+            filled = 0;
         }
+    }
+
+    /// The step's batches.
+    pub fn batches(&self) -> &[ManifoldBatch] {
+        &self.batches[..self.batch_count]
+    }
+
+    /// The step's work and its batches, to solve them.
+    pub fn work(&mut self) -> (&[PassItem], &mut [ManifoldBatch]) {
+        (&self.items, &mut self.batches[..self.batch_count])
+    }
+
+    fn add_batch(&mut self, firsts: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
+        if self.batch_count == self.batches.len() {
+            self.batches.push(ManifoldBatch::default());
+        }
+        self.batches[self.batch_count].fill(firsts, points, bodies);
+        self.items.push(PassItem::Batch(self.batch_count as u32));
+        self.batch_count += 1;
     }
 
     /// A manifold's colour, counted from 1 (0: none free, solved first), marking it taken
@@ -151,7 +172,7 @@ impl PassPlan {
 }
 
 /// One point of each lane's manifold.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct LanePoints {
     normal_lever_a: f64x4,
     normal_lever_b: f64x4,
@@ -172,7 +193,7 @@ struct LanePoints {
 
 /// Four manifolds with no moving body in common, their data lane by lane; each manifold's
 /// points stay in `points` too, which this batch updates at the end of the substeps.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub(super) struct ManifoldBatch {
     /// The first of each lane's two points in `points`.
     first_point: [u32; LANES],
@@ -321,53 +342,45 @@ impl ManifoldBatch {
         self.solve_lanes(bodies, pass)
     }
 
-    fn gather(first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) -> Self {
-        let p = |k: usize, which: usize| &points[first_point[k] as usize + which];
-        let block = |k: usize| {
-            p(k, 0)
-                .pair_coupling
-                .expect("batched manifolds are coupled")
-        };
-        let a = std::array::from_fn(|k| p(k, 0).a);
-        let b = std::array::from_fn(|k| p(k, 0).b);
-        let body = |i: u32| &bodies[i as usize];
-        let point = |which: usize| LanePoints {
-            normal_lever_a: lanes(|k| p(k, which).levers.normal.0),
-            normal_lever_b: lanes(|k| p(k, which).levers.normal.1),
-            tangent_lever_a: lanes(|k| p(k, which).levers.tangent.0),
-            tangent_lever_b: lanes(|k| p(k, which).levers.tangent.1),
-            reach_a: lanes(|k| p(k, which).levers.reach.0),
-            reach_b: lanes(|k| p(k, which).levers.reach.1),
-            base_separation: lanes(|k| p(k, which).base_separation),
-            normal_mass: lanes(|k| p(k, which).normal_mass),
-            tangent_mass: lanes(|k| p(k, which).tangent_mass),
-            restitution: lanes(|k| p(k, which).restitution),
-            relative_velocity: lanes(|k| p(k, which).relative_velocity),
-            normal_impulse: lanes(|k| p(k, which).normal_impulse),
-            tangent_impulse: lanes(|k| p(k, which).tangent_impulse),
-            max_normal_impulse: lanes(|k| p(k, which).max_normal_impulse),
-            closing_acceleration: lanes(|k| p(k, which).closing_acceleration),
-        };
-        Self {
-            first_point,
-            a,
-            b,
-            inv_mass_a: lanes(|k| body(a[k]).inv_mass),
-            inv_mass_b: lanes(|k| body(b[k]).inv_mass),
-            inv_inertia_a: lanes(|k| body(a[k]).inv_inertia),
-            inv_inertia_b: lanes(|k| body(b[k]).inv_inertia),
-            normal_x: lanes(|k| p(k, 0).normal.x),
-            normal_y: lanes(|k| p(k, 0).normal.y),
-            friction: lanes(|k| p(k, 0).friction),
-            k11: lanes(|k| block(k).k11),
-            k12: lanes(|k| block(k).k12),
-            k22: lanes(|k| block(k).k22),
-            inverse: (
-                lanes(|k| block(k).inverse.0),
-                lanes(|k| block(k).inverse.1),
-                lanes(|k| block(k).inverse.2),
-            ),
-            points: [point(0), point(1)],
+    /// Fills the batch with the manifolds whose first points are `first_point`.
+    fn fill(&mut self, first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
+        self.first_point = first_point;
+        for (k, &first) in first_point.iter().enumerate() {
+            let p = &points[first as usize];
+            let block = p.pair_coupling.expect("batched manifolds are coupled");
+            let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+            self.a[k] = p.a;
+            self.b[k] = p.b;
+            self.inv_mass_a.0[k] = a.inv_mass;
+            self.inv_mass_b.0[k] = b.inv_mass;
+            self.inv_inertia_a.0[k] = a.inv_inertia;
+            self.inv_inertia_b.0[k] = b.inv_inertia;
+            self.normal_x.0[k] = p.normal.x;
+            self.normal_y.0[k] = p.normal.y;
+            self.friction.0[k] = p.friction;
+            self.k11.0[k] = block.k11;
+            self.k12.0[k] = block.k12;
+            self.k22.0[k] = block.k22;
+            self.inverse.0.0[k] = block.inverse.0;
+            self.inverse.1.0[k] = block.inverse.1;
+            self.inverse.2.0[k] = block.inverse.2;
+            for (lane, p) in self.points.iter_mut().zip(&points[first as usize..]) {
+                lane.normal_lever_a.0[k] = p.levers.normal.0;
+                lane.normal_lever_b.0[k] = p.levers.normal.1;
+                lane.tangent_lever_a.0[k] = p.levers.tangent.0;
+                lane.tangent_lever_b.0[k] = p.levers.tangent.1;
+                lane.reach_a.0[k] = p.levers.reach.0;
+                lane.reach_b.0[k] = p.levers.reach.1;
+                lane.base_separation.0[k] = p.base_separation;
+                lane.normal_mass.0[k] = p.normal_mass;
+                lane.tangent_mass.0[k] = p.tangent_mass;
+                lane.restitution.0[k] = p.restitution;
+                lane.relative_velocity.0[k] = p.relative_velocity;
+                lane.normal_impulse.0[k] = p.normal_impulse;
+                lane.tangent_impulse.0[k] = p.tangent_impulse;
+                lane.max_normal_impulse.0[k] = p.max_normal_impulse;
+                lane.closing_acceleration.0[k] = p.closing_acceleration;
+            }
         }
     }
 
@@ -728,7 +741,8 @@ mod tests {
                         &pass,
                     );
                 }
-                let mut batch = ManifoldBatch::gather(FIRSTS, &points, &bodies);
+                let mut batch = ManifoldBatch::default();
+                batch.fill(FIRSTS, &points, &bodies);
                 let (mut lanes, mut lane_points) = (bodies.clone(), points.clone());
                 batch.solve(&mut lanes, &pass);
                 batch.scatter(&mut lane_points);
@@ -739,7 +753,7 @@ mod tests {
                     "seed {seed}, bias {use_bias}"
                 );
                 // And the code compiled without AVX2 gives the same bits.
-                let mut batch = ManifoldBatch::gather(FIRSTS, &points, &bodies);
+                batch.fill(FIRSTS, &points, &bodies);
                 let (mut generic, mut generic_points) = (bodies.clone(), points.clone());
                 batch.solve_lanes(&mut generic, &pass);
                 batch.scatter(&mut generic_points);
@@ -760,7 +774,9 @@ mod tests {
                 warm_start_point(&mut one_by_one, p);
             }
             let mut lanes = bodies.clone();
-            ManifoldBatch::gather(FIRSTS, &points, &bodies).warm_start(&mut lanes);
+            let mut batch = ManifoldBatch::default();
+            batch.fill(FIRSTS, &points, &bodies);
+            batch.warm_start(&mut lanes);
             assert_eq!(state(&lanes, &[]), state(&one_by_one, &[]), "seed {seed}");
         }
     }
@@ -790,7 +806,7 @@ mod tests {
         for item in &plan.items {
             let firsts: Vec<u32> = match *item {
                 PassItem::Batch(k) => {
-                    let batch = &plan.batches[k as usize];
+                    let batch = &plan.batches()[k as usize];
                     let mut moving: Vec<u32> = (0..LANES)
                         .flat_map(|l| [batch.a[l], batch.b[l]])
                         .filter(|&i| i != 0)
