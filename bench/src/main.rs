@@ -1,7 +1,8 @@
 //! Times `pe` (contact solvers `exact`, `soft` and `auto`) against rapier2d and Box2D v3 on
 //! scenes with known answers, and writes the results as Markdown to docs/bench/results.md;
 //! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots; with
-//! `pe <scene> [solver]`, one scene in pe alone (for profiling), printing its outcome.
+//! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
+//! outcome.
 //!
 //! Run with `cargo run --release [-- sweep | -- pe smash soft]` inside bench/.
 
@@ -167,8 +168,8 @@ fn main() {
     write_doc(docs, "results.md", &report);
 }
 
-/// `pe <scene> [solver]`: one pile, grid or smash scene in pe alone, so that a profiler
-/// sees only pe's step.
+/// `pe <scene> [solver] [fresh]`: one pile, grid or smash scene in pe alone, so that a
+/// profiler sees only pe's step (`fresh`: no manifold reuse).
 fn run_pe_alone() {
     let scene = std::env::args().nth(2).unwrap_or_default();
     let solver_name = std::env::args().nth(3).unwrap_or_else(|| "soft".into());
@@ -176,7 +177,10 @@ fn run_pe_alone() {
         eprintln!("unknown solver {solver_name:?}");
         std::process::exit(2);
     };
-    let config = PeConfig::new(solver);
+    let config = PeConfig {
+        reuse_manifolds: std::env::args().nth(4).as_deref() != Some("fresh"),
+        ..PeConfig::new(solver)
+    };
     let outcome = if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
         pe_scenes::pyramid(config, spec, H)
     } else if scene == joint_grid::NAME {
