@@ -72,6 +72,13 @@ impl StepSettings {
         0.02 * self.length_scale
     }
 
+    /// The broad phase pairs bodies by their bounds grown by this much, and keeps those
+    /// pairs while every body's bounds stay inside its grown ones (Box2D's fat bounds,
+    /// 0.1 m for its 1 m boxes): a pile at rest is not paired again every step.
+    pub fn broad_phase_margin(&self) -> f64 {
+        0.1 * self.length_scale
+    }
+
     /// A body slower than this (at its farthest point) counts as still, for sleeping.
     pub fn sleep_speed(&self) -> f64 {
         0.05 * self.length_scale
@@ -218,6 +225,12 @@ struct Scratch {
     boxes: Vec<Option<Aabb>>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
+    /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin`, which
+    /// bodies were fixed then, and whether they still stand (see `find_candidate_pairs`).
+    fat_boxes: Vec<Option<Aabb>>,
+    fat_pairs: Vec<(u32, u32)>,
+    fat_fixed: Vec<bool>,
+    fat_pairs_valid: bool,
     solver_bodies: Vec<SolverBody>,
     /// How far each body can move this step.
     reach: Vec<f64>,
@@ -420,6 +433,7 @@ impl World {
         if !std::mem::take(&mut self.collision_filter_stale) {
             return;
         }
+        self.scratch.fat_pairs_valid = false;
         self.jointed.clear();
         self.jointed.extend(
             self.joints
@@ -1355,12 +1369,45 @@ impl World {
         let bodies = &self.bodies;
         // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
         let is_fixed = |i: usize| bodies[i].as_ref().is_none_or(Body::is_fixed);
-        let non_colliding = &self.non_colliding;
-        let wanted = |i: usize, j: usize| {
-            !(is_fixed(i) && is_fixed(j))
-                && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
+        // The grown bounds' pairs still hold every pair whose bounds overlap now if every
+        // body's bounds lie inside its grown ones, and the same bodies are fixed.
+        let still_inside = s.fat_boxes.len() == s.boxes.len()
+            && s.boxes
+                .iter()
+                .zip(&s.fat_boxes)
+                .all(|(now, fat)| match (now, fat) {
+                    (Some(now), Some(fat)) => fat.contains(now),
+                    (None, None) => true,
+                    _ => false,
+                });
+        let same_fixed = s.fat_fixed.len() == bodies.len()
+            && s.fat_fixed
+                .iter()
+                .enumerate()
+                .all(|(i, &f)| f == is_fixed(i));
+        if !(s.fat_pairs_valid && still_inside && same_fixed) {
+            let grow = self.settings.broad_phase_margin();
+            s.fat_boxes.clear();
+            s.fat_boxes
+                .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
+            s.fat_fixed.clear();
+            s.fat_fixed.extend((0..bodies.len()).map(is_fixed));
+            let non_colliding = &self.non_colliding;
+            let wanted = |i: usize, j: usize| {
+                !(is_fixed(i) && is_fixed(j))
+                    && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
+            };
+            s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
+            s.fat_pairs_valid = true;
+        }
+        // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
+        let boxes = &s.boxes;
+        let overlap = |&(i, j): &(u32, u32)| match (&boxes[i as usize], &boxes[j as usize]) {
+            (Some(a), Some(b)) => a.overlaps(b),
+            _ => false,
         };
-        s.broad_phase.pairs(&s.boxes, wanted, &mut s.pairs);
+        s.pairs.clear();
+        s.pairs.extend(s.fat_pairs.iter().copied().filter(overlap));
     }
 
     /// Broad phase, then SAT on each candidate pair (SPEC §3.1), or the pair's last
@@ -1575,5 +1622,68 @@ impl World {
             b.force = Vec2::zeros();
             b.torque = 0.0;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::ConvexPolygon;
+
+    /// The broad phase keeps its pairs while bodies stay inside their grown bounds; the
+    /// candidates must still be exactly the pairs whose bounds overlap now.
+    #[test]
+    fn candidates_are_the_overlapping_pairs_while_the_broad_phase_keeps_its_pairs() {
+        let mut world = World::new(Vec2::zeros());
+        world.settings.contact_solver = ContactSolver::Soft;
+        let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        // A grid of boxes drifting slowly, each its own way: a few hundredths of a box
+        // per step, so that the grown bounds hold for some steps and not for others.
+        for i in 0..8 {
+            for j in 0..8 {
+                let (x, y) = (1.3 * i as f64, 1.3 * j as f64);
+                let v = Vec2::new(
+                    ((3 * i + j) % 5) as f64 - 2.0,
+                    ((i + 2 * j) % 5) as f64 - 2.0,
+                );
+                let def = BodyDef::new(square.clone(), 1.0).at(Vec2::new(x, y), 0.0);
+                world.add_body(def.velocity(v * 0.9, 0.3)).unwrap();
+            }
+        }
+        world
+            .add_body(
+                BodyDef::new(ConvexPolygon::rectangle(30.0, 1.0).unwrap(), 0.0)
+                    .at(Vec2::new(4.5, 11.0), 0.0),
+            )
+            .unwrap();
+        let dt = 1.0 / 60.0;
+        let (mut kept, mut found) = (0, 0);
+        for _ in 0..300 {
+            world.step(dt);
+            let before = world.scratch.fat_boxes.clone();
+            world.find_candidate_pairs(dt);
+            let s = &world.scratch;
+            if s.fat_boxes == before {
+                kept += 1;
+            } else {
+                found += 1;
+            }
+            let n = s.boxes.len();
+            let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
+            let overlapping: Vec<(u32, u32)> = (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .filter(|&(i, j)| !(fixed(i) && fixed(j)))
+                .filter(|&(i, j)| match (&s.boxes[i], &s.boxes[j]) {
+                    (Some(a), Some(b)) => a.overlaps(b),
+                    _ => false,
+                })
+                .map(|(i, j)| (i as u32, j as u32))
+                .collect();
+            assert_eq!(s.pairs, overlapping);
+        }
+        assert!(
+            kept > 20 && found > 20,
+            "pairs kept {kept} times, found {found} times"
+        );
     }
 }

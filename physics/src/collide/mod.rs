@@ -26,6 +26,14 @@ impl Aabb {
             && other.min.y <= self.max.y
     }
 
+    /// Whether `inner` lies inside this box.
+    pub fn contains(&self, inner: &Aabb) -> bool {
+        self.min.x <= inner.min.x
+            && self.min.y <= inner.min.y
+            && inner.max.x <= self.max.x
+            && inner.max.y <= self.max.y
+    }
+
     pub fn grown(&self, by: f64) -> Aabb {
         let d = Vec2::new(by, by);
         Aabb {
