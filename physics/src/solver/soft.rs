@@ -277,6 +277,9 @@ impl SoftStepSolver {
         for batch in self.plan.batches() {
             batch.scatter(&mut self.points);
         }
+        for batch in self.plan.point_batches() {
+            batch.scatter(&mut self.points);
+        }
         self.restitution(bounce_below);
         self.store(bodies, contacts, joints);
         self.report();
@@ -498,10 +501,11 @@ impl SoftStepSolver {
         for p in self.points.iter().filter(|p| p.in_lcp) {
             warm_start_point(&mut self.bodies, p);
         }
-        let batches = self.plan.batches();
+        let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         for item in &self.plan.items {
             match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start(&mut self.bodies),
+                PassItem::PointBatch(k) => point_batches[k as usize].warm_start(&mut self.bodies),
                 PassItem::Manifold(first, count) => {
                     let (first, count) = (first as usize, count as usize);
                     for p in &self.points[first..first + count] {
@@ -560,10 +564,11 @@ impl SoftStepSolver {
             .solve(&mut self.bodies, &mut self.points, &pass);
         // In the plan's order: big islands colour by colour, four manifolds at a time
         // (see `batch`), small ones in the points' order.
-        let (items, batches) = self.plan.work();
+        let (items, batches, point_batches) = self.plan.work();
         for item in items {
             match *item {
                 PassItem::Batch(k) => batches[k as usize].solve(&mut self.bodies, &pass),
+                PassItem::PointBatch(k) => point_batches[k as usize].solve(&mut self.bodies, &pass),
                 PassItem::Manifold(first, 2) => {
                     let i = first as usize;
                     let (first, second) = self.points.split_at_mut(i + 1);

@@ -6,9 +6,10 @@
 //! bodies from the first colour up, those against a fixed body from the last colour down,
 //! so that contacts with the ground have the last word in every pass. (Against a fixed
 //! body first, the 100-row pyramid fell: 2,068 of 5,050 boxes.) Within a colour, four
-//! coupled two-point manifolds at a time are one `ManifoldBatch`, solved with the same
-//! arithmetic as `solve_pair`, lane by lane, so a batch gives the same bits as its four
-//! manifolds solved one after another. Small islands keep the points' order, one
+//! coupled two-point manifolds at a time are one `ManifoldBatch<2>`, and four one-point
+//! ones a `ManifoldBatch<1>`, solved with the same arithmetic as `solve_pair` and
+//! `solve_point`, lane by lane, so a batch gives the same bits as its four manifolds
+//! solved one after another. Small islands keep the points' order, one
 //! manifold at a time.
 //!
 //! Against the points' order (by body pair: a pile's bottom row first), colours stand the
@@ -35,11 +36,12 @@ const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 /// fewer).
 const MIN_COLOURED_ISLAND: usize = 48;
 
-/// One step of the passes' work, in order: a batch of four manifolds, or one manifold
-/// (`(first point, point count)`) solved alone.
+/// One step of the passes' work, in order: a batch of four two-point manifolds, a batch
+/// of four one-point ones, or one manifold (`(first point, point count)`) solved alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum PassItem {
     Batch(u32),
+    PointBatch(u32),
     Manifold(u32, u32),
 }
 
@@ -47,9 +49,12 @@ pub(super) enum PassItem {
 #[derive(Debug, Clone, Default)]
 pub(super) struct PassPlan {
     pub items: Vec<PassItem>,
-    /// The step's batches are the first `batch_count`; the rest are kept to be refilled.
-    batches: Vec<ManifoldBatch>,
+    /// The step's batches are the first `batch_count` (of two-point manifolds) and
+    /// `point_batch_count` (one-point); the rest are kept to be refilled.
+    batches: Vec<ManifoldBatch<2>>,
     batch_count: usize,
+    point_batches: Vec<ManifoldBatch<1>>,
+    point_batch_count: usize,
     /// Per body, a bit for each colour it already has a manifold in.
     colours_of: Vec<u32>,
     /// `(colour, first point, point count)` of the coloured manifolds.
@@ -67,6 +72,7 @@ impl PassPlan {
     ) {
         self.items.clear();
         self.batch_count = 0;
+        self.point_batch_count = 0;
         self.coloured.clear();
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
@@ -93,40 +99,68 @@ impl PassPlan {
         }
         // A stable sort: each colour keeps the points' order.
         self.coloured.sort_by_key(|c| c.0);
-        let mut lanes = [0; LANES];
-        let mut filled = 0;
+        // Two-point and one-point manifolds fill their own batches, colour by colour.
+        let (mut pairs, mut singles) = ([0; LANES], [0; LANES]);
+        let (mut pairs_filled, mut singles_filled) = (0, 0);
         let mut i = 0;
         while i < self.coloured.len() {
             let colour = self.coloured[i].0;
             while i < self.coloured.len() && self.coloured[i].0 == colour {
                 let (_, first, count) = self.coloured[i];
                 i += 1;
-                let coupled = count == 2 && points[first as usize].pair_coupling.is_some();
-                if colour == 0 || !coupled {
+                if colour == 0 {
                     self.items.push(PassItem::Manifold(first, count));
-                    continue;
-                }
-                lanes[filled] = first;
-                filled += 1;
-                if filled == LANES {
-                    self.add_batch(lanes, points, bodies);
-                    filled = 0;
+                } else if count == 2 {
+                    pairs[pairs_filled] = first;
+                    pairs_filled += 1;
+                    if pairs_filled == LANES {
+                        self.add_batch(pairs, points, bodies);
+                        pairs_filled = 0;
+                    }
+                } else {
+                    singles[singles_filled] = first;
+                    singles_filled += 1;
+                    if singles_filled == LANES {
+                        self.add_point_batch(singles, points, bodies);
+                        singles_filled = 0;
+                    }
                 }
             }
-            let rest = lanes[..filled].iter().map(|&f| PassItem::Manifold(f, 2));
+            let rest = pairs[..pairs_filled]
+                .iter()
+                .map(|&f| PassItem::Manifold(f, 2));
             self.items.extend(rest);
-            filled = 0;
+            let rest = singles[..singles_filled]
+                .iter()
+                .map(|&f| PassItem::Manifold(f, 1));
+            self.items.extend(rest);
+            (pairs_filled, singles_filled) = (0, 0);
         }
     }
 
-    /// The step's batches.
-    pub fn batches(&self) -> &[ManifoldBatch] {
+    /// The step's batches of two-point manifolds.
+    pub fn batches(&self) -> &[ManifoldBatch<2>] {
         &self.batches[..self.batch_count]
     }
 
+    /// The step's batches of one-point manifolds.
+    pub fn point_batches(&self) -> &[ManifoldBatch<1>] {
+        &self.point_batches[..self.point_batch_count]
+    }
+
     /// The step's work and its batches, to solve them.
-    pub fn work(&mut self) -> (&[PassItem], &mut [ManifoldBatch]) {
-        (&self.items, &mut self.batches[..self.batch_count])
+    pub fn work(
+        &mut self,
+    ) -> (
+        &[PassItem],
+        &mut [ManifoldBatch<2>],
+        &mut [ManifoldBatch<1>],
+    ) {
+        (
+            &self.items,
+            &mut self.batches[..self.batch_count],
+            &mut self.point_batches[..self.point_batch_count],
+        )
     }
 
     fn add_batch(&mut self, firsts: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
@@ -136,6 +170,21 @@ impl PassPlan {
         self.batches[self.batch_count].fill(firsts, points, bodies);
         self.items.push(PassItem::Batch(self.batch_count as u32));
         self.batch_count += 1;
+    }
+
+    fn add_point_batch(
+        &mut self,
+        firsts: [u32; LANES],
+        points: &[PointConstraint],
+        bodies: &[SoftBody],
+    ) {
+        if self.point_batch_count == self.point_batches.len() {
+            self.point_batches.push(ManifoldBatch::default());
+        }
+        self.point_batches[self.point_batch_count].fill(firsts, points, bodies);
+        self.items
+            .push(PassItem::PointBatch(self.point_batch_count as u32));
+        self.point_batch_count += 1;
     }
 
     /// A manifold's colour, counted from 1 (0: none free, solved first), marking it taken
@@ -191,11 +240,12 @@ struct LanePoints {
     closing_acceleration: f64x4,
 }
 
-/// Four manifolds with no moving body in common, their data lane by lane; each manifold's
-/// points stay in `points` too, which this batch updates at the end of the substeps.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct ManifoldBatch {
-    /// The first of each lane's two points in `points`.
+/// Four manifolds of `N` points (one or two) with no moving body in common, their data
+/// lane by lane; each manifold's points stay in `points` too, which this batch updates at
+/// the end of the substeps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ManifoldBatch<const N: usize> {
+    /// The first of each lane's points in `points`.
     first_point: [u32; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
@@ -209,8 +259,32 @@ pub(super) struct ManifoldBatch {
     k11: f64x4,
     k12: f64x4,
     k22: f64x4,
+    /// The 2 × 2 block (two-point manifolds only).
     inverse: (f64x4, f64x4, f64x4),
-    points: [LanePoints; 2],
+    points: [LanePoints; N],
+}
+
+impl<const N: usize> Default for ManifoldBatch<N> {
+    fn default() -> Self {
+        let zero = f64x4::default();
+        Self {
+            first_point: [0; LANES],
+            a: [0; LANES],
+            b: [0; LANES],
+            inv_mass_a: zero,
+            inv_mass_b: zero,
+            inv_inertia_a: zero,
+            inv_inertia_b: zero,
+            normal_x: zero,
+            normal_y: zero,
+            friction: zero,
+            k11: zero,
+            k12: zero,
+            k22: zero,
+            inverse: (zero, zero, zero),
+            points: [LanePoints::default(); N],
+        }
+    }
 }
 
 fn lanes(f: impl Fn(usize) -> f64) -> f64x4 {
@@ -308,7 +382,7 @@ pub(super) struct PassSettings {
     pub use_bias: bool,
 }
 
-impl ManifoldBatch {
+impl<const N: usize> ManifoldBatch<N> {
     /// `warm_start` for the batch's points.
     pub(super) fn warm_start(&self, bodies: &mut [SoftBody]) {
         #[cfg(target_arch = "x86_64")]
@@ -319,7 +393,7 @@ impl ManifoldBatch {
         self.warm_start_lanes(bodies)
     }
 
-    /// `solve_pair` on every lane.
+    /// `solve_pair` (or `solve_point`) on every lane.
     pub(super) fn solve(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -347,7 +421,6 @@ impl ManifoldBatch {
         self.first_point = first_point;
         for (k, &first) in first_point.iter().enumerate() {
             let p = &points[first as usize];
-            let block = p.pair_coupling.expect("batched manifolds are coupled");
             let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
             self.a[k] = p.a;
             self.b[k] = p.b;
@@ -358,12 +431,15 @@ impl ManifoldBatch {
             self.normal_x.0[k] = p.normal.x;
             self.normal_y.0[k] = p.normal.y;
             self.friction.0[k] = p.friction;
-            self.k11.0[k] = block.k11;
-            self.k12.0[k] = block.k12;
-            self.k22.0[k] = block.k22;
-            self.inverse.0.0[k] = block.inverse.0;
-            self.inverse.1.0[k] = block.inverse.1;
-            self.inverse.2.0[k] = block.inverse.2;
+            if N == 2 {
+                let block = p.pair_coupling.expect("batched pairs are coupled");
+                self.k11.0[k] = block.k11;
+                self.k12.0[k] = block.k12;
+                self.k22.0[k] = block.k22;
+                self.inverse.0.0[k] = block.inverse.0;
+                self.inverse.1.0[k] = block.inverse.1;
+                self.inverse.2.0[k] = block.inverse.2;
+            }
             for (lane, p) in self.points.iter_mut().zip(&points[first as usize..]) {
                 lane.normal_lever_a.0[k] = p.levers.normal.0;
                 lane.normal_lever_b.0[k] = p.levers.normal.1;
@@ -437,7 +513,7 @@ impl ManifoldBatch {
 
     /// `separation` for each lane's point `which`.
     #[inline(always)]
-    fn separations(&self, bodies: &[SoftBody]) -> [f64x4; 2] {
+    fn separations(&self, bodies: &[SoftBody]) -> [f64x4; N] {
         let a = |k: usize| &bodies[self.a[k] as usize];
         let b = |k: usize| &bodies[self.b[k] as usize];
         let dx = lanes(|k| a(k).dp.x - b(k).dp.x);
@@ -451,7 +527,12 @@ impl ManifoldBatch {
             let turned_b = (cos_b - one) * p.reach_b + sin_b * p.normal_lever_b;
             moved + turned_a - turned_b + p.base_separation
         };
-        [separation(&self.points[0]), separation(&self.points[1])]
+        // A loop, not `array::from_fn`, whose closure the compiler left out of line.
+        let mut separations = [f64x4::default(); N];
+        for (s, p) in separations.iter_mut().zip(&self.points) {
+            *s = separation(p);
+        }
+        separations
     }
 
     /// `solve_pair` on every lane.
@@ -483,34 +564,14 @@ impl ManifoldBatch {
                 speculative.select(zero, impulse_scale),
             )
         };
-        let targets = [target(separations[0]), target(separations[1])];
-        // A lane whose points differ in softness (one speculative, one touching) solves
-        // them one after the other, as `solve_pair` does: kept aside, and chosen below.
-        let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
-        let soft_differs =
-            pass.use_bias && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
-        let one_by_one = (soft_differs && mixed.any()).then_some((pair, self.points));
-        let [p, q] = &mut self.points;
-        let v1 = pair.velocity_along(normal, p.normal_lever_a, p.normal_lever_b);
-        approach(p, v1, separations[0]);
-        let v2 = pair.velocity_along(normal, q.normal_lever_a, q.normal_lever_b);
-        approach(q, v2, separations[1]);
-        self.solve_block(&mut pair, [v1, v2], targets);
-        if let Some((mut alone, mut points)) = one_by_one {
-            for (k, p) in points.iter_mut().enumerate() {
-                let (target, mass_scale, impulse_scale) = targets[k];
-                let vn = alone.velocity_along(normal, p.normal_lever_a, p.normal_lever_b);
-                approach(p, vn, separations[k]);
-                let impulse =
-                    -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
-                apply_normal(&mut alone, p, normal, p.normal_impulse + impulse);
-            }
-            pair = LanePair::select(mixed, alone, pair);
-            for (p, q) in self.points.iter_mut().zip(points) {
-                p.normal_impulse = mixed.select(q.normal_impulse, p.normal_impulse);
-                p.max_normal_impulse = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
-                p.relative_velocity = mixed.select(q.relative_velocity, p.relative_velocity);
-            }
+        let mut targets = [(zero, zero, zero); N];
+        for (t, &s) in targets.iter_mut().zip(&separations) {
+            *t = target(s);
+        }
+        if N == 2 {
+            self.solve_normals_together(&mut pair, &separations, &targets, pass);
+        } else {
+            solve_normals_alone(&mut pair, &mut self.points, normal, &separations, &targets);
         }
         let tangent = (-self.normal_y, self.normal_x);
         for p in &mut self.points {
@@ -526,6 +587,40 @@ impl ManifoldBatch {
         self.store(&pair, bodies);
     }
 
+    /// A two-point manifold's normals, as `solve_pair` solves them: together, except in
+    /// lanes whose points differ in softness (one speculative, one touching), which solve
+    /// them one after the other; both are computed there, and the lane's chosen.
+    #[inline(always)]
+    fn solve_normals_together(
+        &mut self,
+        pair: &mut LanePair,
+        separations: &[f64x4],
+        targets: &[Target],
+        pass: &PassSettings,
+    ) {
+        let zero = f64x4::splat(0.0);
+        let normal = (self.normal_x, self.normal_y);
+        let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
+        let soft_differs =
+            pass.use_bias && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
+        let one_by_one = (soft_differs && mixed.any()).then_some((*pair, self.points));
+        let points = &mut self.points[..];
+        let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
+        approach(&mut points[0], v1, separations[0]);
+        let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
+        approach(&mut points[1], v2, separations[1]);
+        self.solve_block(pair, [v1, v2], [targets[0], targets[1]]);
+        if let Some((mut alone, mut points)) = one_by_one {
+            solve_normals_alone(&mut alone, &mut points, normal, separations, targets);
+            *pair = LanePair::select(mixed, alone, *pair);
+            for (p, q) in self.points.iter_mut().zip(points) {
+                p.normal_impulse = mixed.select(q.normal_impulse, p.normal_impulse);
+                p.max_normal_impulse = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
+                p.relative_velocity = mixed.select(q.relative_velocity, p.relative_velocity);
+            }
+        }
+    }
+
     /// `solve_normal_pair` on every lane: the active set of each lane's 2 × 2 LCP chosen
     /// by masks.
     #[inline(always)]
@@ -533,18 +628,19 @@ impl ManifoldBatch {
         &mut self,
         pair: &mut LanePair,
         [v1, v2]: [f64x4; 2],
-        [(t1, ms1, s1), (t2, ms2, s2)]: [(f64x4, f64x4, f64x4); 2],
+        [(t1, ms1, s1), (t2, ms2, s2)]: [Target; 2],
     ) {
         let zero = f64x4::splat(0.0);
-        let (x1, x2) = (self.points[0].normal_impulse, self.points[1].normal_impulse);
+        let points = &self.points[..];
+        let (x1, x2) = (points[0].normal_impulse, points[1].normal_impulse);
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
         let spring12 = k12.min(zero);
         let r1 = ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2);
         let r2 = ms2 * (v2 - t2) - (k12 * x1 + k22 * x2) + s2 * (spring12 * x1 + k22 * x2);
         let (i11, i12, i22) = self.inverse;
         let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
-        let first = -r1 * self.points[0].normal_mass;
-        let second = -r2 * self.points[1].normal_mass;
+        let first = -r1 * points[0].normal_mass;
+        let second = -r2 * points[1].normal_mass;
         let take_both = both.0.ge(zero) & both.1.ge(zero);
         let take_first = first.ge(zero) & (k12 * first + r2).ge(zero);
         let take_second = second.ge(zero) & (k12 * second + r1).ge(zero);
@@ -557,6 +653,29 @@ impl ManifoldBatch {
         for (p, total) in self.points.iter_mut().zip([total1, total2]) {
             apply_normal(pair, p, normal, total);
         }
+    }
+}
+
+/// A point's normal target, mass scale and impulse scale (see `normal_target`), lane by
+/// lane.
+type Target = (f64x4, f64x4, f64x4);
+
+/// `solve_normal` on every lane, point after point.
+#[inline(always)]
+fn solve_normals_alone(
+    pair: &mut LanePair,
+    points: &mut [LanePoints],
+    normal: (f64x4, f64x4),
+    separations: &[f64x4],
+    targets: &[Target],
+) {
+    for (k, p) in points.iter_mut().enumerate() {
+        let (target, mass_scale, impulse_scale) = targets[k];
+        let vn = pair.velocity_along(normal, p.normal_lever_a, p.normal_lever_b);
+        approach(p, vn, separations[k]);
+        let impulse =
+            -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
+        apply_normal(pair, p, normal, p.normal_impulse + impulse);
     }
 }
 
@@ -586,7 +705,7 @@ fn approach(p: &mut LanePoints, vn: f64x4, separation: f64x4) {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{NormalBlock, PointLevers, solve_pair, warm_start_point};
+    use super::super::{NormalBlock, PointLevers, solve_pair, solve_point, warm_start_point};
     use super::*;
     use crate::math::{Rot, Vec2, cross, perp};
 
@@ -741,7 +860,7 @@ mod tests {
                         &pass,
                     );
                 }
-                let mut batch = ManifoldBatch::default();
+                let mut batch = ManifoldBatch::<2>::default();
                 batch.fill(FIRSTS, &points, &bodies);
                 let (mut lanes, mut lane_points) = (bodies.clone(), points.clone());
                 batch.solve(&mut lanes, &pass);
@@ -766,6 +885,48 @@ mod tests {
     }
 
     #[test]
+    fn a_batch_of_one_point_manifolds_solves_as_they_do_one_after_another() {
+        for seed in 1..200 {
+            // The first point of each of four manifolds, each alone.
+            let (bodies, pairs) = four_manifolds(seed);
+            let points: Vec<PointConstraint> = pairs
+                .iter()
+                .step_by(2)
+                .map(|p| PointConstraint {
+                    pair_coupling: None,
+                    ..*p
+                })
+                .collect();
+            let firsts = [0, 1, 2, 3];
+            for use_bias in [true, false] {
+                let pass = pass(use_bias);
+                let (mut one_by_one, mut their_points) = (bodies.clone(), points.clone());
+                for p in &mut their_points {
+                    solve_point(&mut one_by_one, p, &pass);
+                }
+                let mut batch = ManifoldBatch::<1>::default();
+                batch.fill(firsts, &points, &bodies);
+                let (mut lanes, mut lane_points) = (bodies.clone(), points.clone());
+                batch.solve(&mut lanes, &pass);
+                batch.scatter(&mut lane_points);
+                assert_eq!(
+                    state(&lanes, &lane_points),
+                    state(&one_by_one, &their_points),
+                    "seed {seed}, bias {use_bias}"
+                );
+                batch.fill(firsts, &points, &bodies);
+                let (mut generic, mut generic_points) = (bodies.clone(), points.clone());
+                batch.solve_lanes(&mut generic, &pass);
+                batch.scatter(&mut generic_points);
+                assert_eq!(
+                    state(&generic, &generic_points),
+                    state(&lanes, &lane_points)
+                );
+            }
+        }
+    }
+
+    #[test]
     fn a_batch_warm_starts_as_its_points_one_after_another() {
         for seed in 1..50 {
             let (bodies, points) = four_manifolds(seed);
@@ -774,7 +935,7 @@ mod tests {
                 warm_start_point(&mut one_by_one, p);
             }
             let mut lanes = bodies.clone();
-            let mut batch = ManifoldBatch::default();
+            let mut batch = ManifoldBatch::<2>::default();
             batch.fill(FIRSTS, &points, &bodies);
             batch.warm_start(&mut lanes);
             assert_eq!(state(&lanes, &[]), state(&one_by_one, &[]), "seed {seed}");
@@ -798,44 +959,55 @@ mod tests {
 
     #[test]
     fn the_plan_takes_every_manifold_once_batches_none_sharing_a_body_and_grounds_last() {
-        let (bodies, points) = row_on_floor(40);
+        let (bodies, mut points) = row_on_floor(40);
+        // Every third manifold uncoupled: its points are two one-point manifolds.
+        for m in (0..points.len() / 2).step_by(3) {
+            points[2 * m].pair_coupling = None;
+        }
         let mut plan = PassPlan::default();
         plan.plan(&[(0, points.len())], &points, &bodies);
         let mut seen = vec![0; points.len()];
         let mut order = Vec::new();
         for item in &plan.items {
+            let lanes_share_no_moving_body = |a: &[u32; LANES], b: &[u32; LANES]| {
+                let mut moving: Vec<u32> = a.iter().chain(b).copied().filter(|&i| i != 0).collect();
+                let len = moving.len();
+                moving.sort_unstable();
+                moving.dedup();
+                moving.len() == len
+            };
             let firsts: Vec<u32> = match *item {
                 PassItem::Batch(k) => {
                     let batch = &plan.batches()[k as usize];
-                    let mut moving: Vec<u32> = (0..LANES)
-                        .flat_map(|l| [batch.a[l], batch.b[l]])
-                        .filter(|&i| i != 0)
-                        .collect();
-                    let len = moving.len();
-                    moving.sort_unstable();
-                    moving.dedup();
-                    assert_eq!(moving.len(), len, "a batch's lanes share a moving body");
+                    assert!(lanes_share_no_moving_body(&batch.a, &batch.b));
                     batch.first_point.to_vec()
                 }
-                PassItem::Manifold(first, count) => {
-                    assert_eq!(count, 2);
-                    vec![first]
+                PassItem::PointBatch(k) => {
+                    let batch = &plan.point_batches()[k as usize];
+                    assert!(lanes_share_no_moving_body(&batch.a, &batch.b));
+                    batch.first_point.to_vec()
                 }
+                PassItem::Manifold(first, _) => vec![first],
             };
             for f in firsts {
                 seen[f as usize] += 1;
                 order.push(f);
             }
         }
-        let firsts_of_manifolds: Vec<usize> = (0..points.len()).step_by(2).collect();
+        // Each coupled manifold once by its first point, each point of the others once.
+        let mut expected = vec![0; points.len()];
+        for m in 0..points.len() / 2 {
+            expected[2 * m] = 1;
+            if points[2 * m].pair_coupling.is_none() {
+                expected[2 * m + 1] = 1;
+            }
+        }
+        assert_eq!(seen, expected);
+        let (batches, point_batches) = (plan.batches().len(), plan.point_batches().len());
+        assert!(batches >= 10, "{batches} batches of 52 two-point manifolds");
         assert!(
-            firsts_of_manifolds.iter().all(|&f| seen[f] == 1),
-            "{seen:?}"
-        );
-        assert!(
-            plan.batches.len() >= 15,
-            "{} batches of 79 manifolds",
-            plan.batches.len()
+            point_batches >= 8,
+            "{point_batches} batches of 54 one-point ones"
         );
         // Every contact with the floor after every contact between boxes.
         let on_floor = |f: &u32| points[*f as usize].a == 0;
