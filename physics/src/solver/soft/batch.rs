@@ -845,6 +845,32 @@ mod tests {
         v.chain(p).collect()
     }
 
+    /// Solves the manifolds starting at `firsts` as one batch, through `solve` (AVX2
+    /// where the processor has it) and through the code compiled without it, and checks
+    /// that both leave exactly the `expected` state: each lane runs the scalar arithmetic
+    /// in the scalar order.
+    fn assert_batch_gives<const N: usize>(
+        (bodies, points): (&[SoftBody], &[PointConstraint]),
+        firsts: [u32; LANES],
+        pass: &PassSettings,
+        expected: &[f64],
+        label: &str,
+    ) {
+        for dispatched in [true, false] {
+            let mut batch = ManifoldBatch::<N>::default();
+            batch.fill(firsts, points, bodies);
+            let (mut lanes, mut lane_points) = (bodies.to_vec(), points.to_vec());
+            if dispatched {
+                batch.solve(&mut lanes, pass);
+            } else {
+                batch.solve_lanes(&mut lanes, pass);
+            }
+            batch.scatter(&mut lane_points);
+            let path = if dispatched { "dispatched" } else { "generic" };
+            assert_eq!(state(&lanes, &lane_points), expected, "{label}, {path}");
+        }
+    }
+
     #[test]
     fn a_batch_solves_as_its_manifolds_one_after_another() {
         for seed in 1..200 {
@@ -860,26 +886,9 @@ mod tests {
                         &pass,
                     );
                 }
-                let mut batch = ManifoldBatch::<2>::default();
-                batch.fill(FIRSTS, &points, &bodies);
-                let (mut lanes, mut lane_points) = (bodies.clone(), points.clone());
-                batch.solve(&mut lanes, &pass);
-                batch.scatter(&mut lane_points);
-                // Exactly: each lane runs the scalar arithmetic in the scalar order.
-                assert_eq!(
-                    state(&lanes, &lane_points),
-                    state(&one_by_one, &their_points),
-                    "seed {seed}, bias {use_bias}"
-                );
-                // And the code compiled without AVX2 gives the same bits.
-                batch.fill(FIRSTS, &points, &bodies);
-                let (mut generic, mut generic_points) = (bodies.clone(), points.clone());
-                batch.solve_lanes(&mut generic, &pass);
-                batch.scatter(&mut generic_points);
-                assert_eq!(
-                    state(&generic, &generic_points),
-                    state(&lanes, &lane_points)
-                );
+                let expected = state(&one_by_one, &their_points);
+                let label = format!("seed {seed}, bias {use_bias}");
+                assert_batch_gives::<2>((&bodies, &points), FIRSTS, &pass, &expected, &label);
             }
         }
     }
@@ -904,24 +913,9 @@ mod tests {
                 for p in &mut their_points {
                     solve_point(&mut one_by_one, p, &pass);
                 }
-                let mut batch = ManifoldBatch::<1>::default();
-                batch.fill(firsts, &points, &bodies);
-                let (mut lanes, mut lane_points) = (bodies.clone(), points.clone());
-                batch.solve(&mut lanes, &pass);
-                batch.scatter(&mut lane_points);
-                assert_eq!(
-                    state(&lanes, &lane_points),
-                    state(&one_by_one, &their_points),
-                    "seed {seed}, bias {use_bias}"
-                );
-                batch.fill(firsts, &points, &bodies);
-                let (mut generic, mut generic_points) = (bodies.clone(), points.clone());
-                batch.solve_lanes(&mut generic, &pass);
-                batch.scatter(&mut generic_points);
-                assert_eq!(
-                    state(&generic, &generic_points),
-                    state(&lanes, &lane_points)
-                );
+                let expected = state(&one_by_one, &their_points);
+                let label = format!("seed {seed}, bias {use_bias}");
+                assert_batch_gives::<1>((&bodies, &points), firsts, &pass, &expected, &label);
             }
         }
     }
