@@ -17,7 +17,7 @@
 //! against 0.0036 and 0.016) but the 100-row one less still (largest drift 29% of a box,
 //! against 12%; Box2D v3 0.4%).
 
-use super::f64x4::{F64x4 as f64x4, Mask4};
+use super::f64x4::{F64x4, Mask4};
 use super::{PointConstraint, SoftBody, Softness};
 
 const LANES: usize = 4;
@@ -223,21 +223,21 @@ impl PassPlan {
 /// One point of each lane's manifold.
 #[derive(Debug, Clone, Copy, Default)]
 struct LanePoints {
-    normal_lever_a: f64x4,
-    normal_lever_b: f64x4,
-    tangent_lever_a: f64x4,
-    tangent_lever_b: f64x4,
-    reach_a: f64x4,
-    reach_b: f64x4,
-    base_separation: f64x4,
-    normal_mass: f64x4,
-    tangent_mass: f64x4,
-    restitution: f64x4,
-    relative_velocity: f64x4,
-    normal_impulse: f64x4,
-    tangent_impulse: f64x4,
-    max_normal_impulse: f64x4,
-    closing_acceleration: f64x4,
+    normal_lever_a: F64x4,
+    normal_lever_b: F64x4,
+    tangent_lever_a: F64x4,
+    tangent_lever_b: F64x4,
+    reach_a: F64x4,
+    reach_b: F64x4,
+    base_separation: F64x4,
+    normal_mass: F64x4,
+    tangent_mass: F64x4,
+    restitution: F64x4,
+    relative_velocity: F64x4,
+    normal_impulse: F64x4,
+    tangent_impulse: F64x4,
+    max_normal_impulse: F64x4,
+    closing_acceleration: F64x4,
 }
 
 /// Four manifolds of `N` points (one or two) with no moving body in common, their data
@@ -249,24 +249,24 @@ pub(super) struct ManifoldBatch<const N: usize> {
     first_point: [u32; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
-    inv_mass_a: f64x4,
-    inv_mass_b: f64x4,
-    inv_inertia_a: f64x4,
-    inv_inertia_b: f64x4,
-    normal_x: f64x4,
-    normal_y: f64x4,
-    friction: f64x4,
-    k11: f64x4,
-    k12: f64x4,
-    k22: f64x4,
+    inv_mass_a: F64x4,
+    inv_mass_b: F64x4,
+    inv_inertia_a: F64x4,
+    inv_inertia_b: F64x4,
+    normal_x: F64x4,
+    normal_y: F64x4,
+    friction: F64x4,
+    k11: F64x4,
+    k12: F64x4,
+    k22: F64x4,
     /// The 2 × 2 block (two-point manifolds only).
-    inverse: (f64x4, f64x4, f64x4),
+    inverse: (F64x4, F64x4, F64x4),
     points: [LanePoints; N],
 }
 
 impl<const N: usize> Default for ManifoldBatch<N> {
     fn default() -> Self {
-        let zero = f64x4::default();
+        let zero = F64x4::default();
         Self {
             first_point: [0; LANES],
             a: [0; LANES],
@@ -287,16 +287,16 @@ impl<const N: usize> Default for ManifoldBatch<N> {
     }
 }
 
-fn lanes(f: impl Fn(usize) -> f64) -> f64x4 {
-    f64x4::from_fn(f)
+fn lanes(f: impl Fn(usize) -> f64) -> F64x4 {
+    F64x4::from_fn(f)
 }
 
 /// A body's velocity, lane by lane.
 #[derive(Debug, Clone, Copy)]
 struct LaneVelocity {
-    x: f64x4,
-    y: f64x4,
-    w: f64x4,
+    x: F64x4,
+    y: F64x4,
+    w: F64x4,
 }
 
 impl LaneVelocity {
@@ -327,8 +327,8 @@ impl LaneVelocity {
 struct LanePair {
     a: LaneVelocity,
     b: LaneVelocity,
-    inv_mass: (f64x4, f64x4),
-    inv_inertia: (f64x4, f64x4),
+    inv_mass: (F64x4, F64x4),
+    inv_inertia: (F64x4, F64x4),
 }
 
 impl LanePair {
@@ -349,7 +349,7 @@ impl LanePair {
 
     /// `BodyPair::velocity_along`, lane by lane.
     #[inline(always)]
-    fn velocity_along(&self, (dx, dy): (f64x4, f64x4), lever_a: f64x4, lever_b: f64x4) -> f64x4 {
+    fn velocity_along(&self, (dx, dy): (F64x4, F64x4), lever_a: F64x4, lever_b: F64x4) -> F64x4 {
         let (rx, ry) = (self.a.x - self.b.x, self.a.y - self.b.y);
         rx * dx + ry * dy + self.a.w * lever_a - self.b.w * lever_b
     }
@@ -358,10 +358,10 @@ impl LanePair {
     #[inline(always)]
     fn apply_along(
         &mut self,
-        (dx, dy): (f64x4, f64x4),
-        lever_a: f64x4,
-        lever_b: f64x4,
-        impulse: f64x4,
+        (dx, dy): (F64x4, F64x4),
+        lever_a: F64x4,
+        lever_b: F64x4,
+        impulse: F64x4,
     ) {
         let (sa, sb) = (impulse * self.inv_mass.0, impulse * self.inv_mass.1);
         self.a.x += dx * sa;
@@ -513,14 +513,14 @@ impl<const N: usize> ManifoldBatch<N> {
 
     /// `separation` for each lane's point `which`.
     #[inline(always)]
-    fn separations(&self, bodies: &[SoftBody]) -> [f64x4; N] {
+    fn separations(&self, bodies: &[SoftBody]) -> [F64x4; N] {
         let a = |k: usize| &bodies[self.a[k] as usize];
         let b = |k: usize| &bodies[self.b[k] as usize];
         let dx = lanes(|k| a(k).dp.x - b(k).dp.x);
         let dy = lanes(|k| a(k).dp.y - b(k).dp.y);
         let (cos_a, sin_a) = (lanes(|k| a(k).dq.cos), lanes(|k| a(k).dq.sin));
         let (cos_b, sin_b) = (lanes(|k| b(k).dq.cos), lanes(|k| b(k).dq.sin));
-        let one = f64x4::splat(1.0);
+        let one = F64x4::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
         let separation = |p: &LanePoints| {
             let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
@@ -528,7 +528,7 @@ impl<const N: usize> ManifoldBatch<N> {
             moved + turned_a - turned_b + p.base_separation
         };
         // A loop, not `array::from_fn`, whose closure the compiler left out of line.
-        let mut separations = [f64x4::default(); N];
+        let mut separations = [F64x4::default(); N];
         for (s, p) in separations.iter_mut().zip(&self.points) {
             *s = separation(p);
         }
@@ -541,25 +541,25 @@ impl<const N: usize> ManifoldBatch<N> {
         let separations = self.separations(bodies);
         let mut pair = self.load(bodies);
         let normal = (self.normal_x, self.normal_y);
-        let zero = f64x4::splat(0.0);
-        let one = f64x4::splat(1.0);
+        let zero = F64x4::splat(0.0);
+        let one = F64x4::splat(1.0);
         // `normal_target`: speculative points close their gap, touching ones are soft
         // with bias (or rigid in the relax pass).
-        let target = |s: f64x4| {
+        let target = |s: F64x4| {
             let speculative = s.gt(zero);
             let (target, mass_scale, impulse_scale) = if pass.use_bias {
                 let bias =
-                    -(f64x4::splat(pass.soft.bias_rate) * s).max(f64x4::splat(-pass.max_push));
+                    -(F64x4::splat(pass.soft.bias_rate) * s).max(F64x4::splat(-pass.max_push));
                 (
                     bias,
-                    f64x4::splat(pass.soft.mass_scale),
-                    f64x4::splat(pass.soft.impulse_scale),
+                    F64x4::splat(pass.soft.mass_scale),
+                    F64x4::splat(pass.soft.impulse_scale),
                 )
             } else {
                 (zero, one, zero)
             };
             (
-                speculative.select(-s * f64x4::splat(pass.inv_h), target),
+                speculative.select(-s * F64x4::splat(pass.inv_h), target),
                 speculative.select(one, mass_scale),
                 speculative.select(zero, impulse_scale),
             )
@@ -594,11 +594,11 @@ impl<const N: usize> ManifoldBatch<N> {
     fn solve_normals_together(
         &mut self,
         pair: &mut LanePair,
-        separations: &[f64x4],
+        separations: &[F64x4],
         targets: &[Target],
         pass: &PassSettings,
     ) {
-        let zero = f64x4::splat(0.0);
+        let zero = F64x4::splat(0.0);
         let normal = (self.normal_x, self.normal_y);
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
         let soft_differs =
@@ -627,10 +627,10 @@ impl<const N: usize> ManifoldBatch<N> {
     fn solve_block(
         &mut self,
         pair: &mut LanePair,
-        [v1, v2]: [f64x4; 2],
+        [v1, v2]: [F64x4; 2],
         [(t1, ms1, s1), (t2, ms2, s2)]: [Target; 2],
     ) {
-        let zero = f64x4::splat(0.0);
+        let zero = F64x4::splat(0.0);
         let points = &self.points[..];
         let (x1, x2) = (points[0].normal_impulse, points[1].normal_impulse);
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
@@ -658,15 +658,15 @@ impl<const N: usize> ManifoldBatch<N> {
 
 /// A point's normal target, mass scale and impulse scale (see `normal_target`), lane by
 /// lane.
-type Target = (f64x4, f64x4, f64x4);
+type Target = (F64x4, F64x4, F64x4);
 
 /// `solve_normal` on every lane, point after point.
 #[inline(always)]
 fn solve_normals_alone(
     pair: &mut LanePair,
     points: &mut [LanePoints],
-    normal: (f64x4, f64x4),
-    separations: &[f64x4],
+    normal: (F64x4, F64x4),
+    separations: &[F64x4],
     targets: &[Target],
 ) {
     for (k, p) in points.iter_mut().enumerate() {
@@ -682,8 +682,8 @@ fn solve_normals_alone(
 /// `apply_normal` on every lane: the accumulated normal impulse set to `total` (clamped
 /// at 0), the difference applied.
 #[inline(always)]
-fn apply_normal(pair: &mut LanePair, p: &mut LanePoints, normal: (f64x4, f64x4), total: f64x4) {
-    let total = total.max(f64x4::splat(0.0));
+fn apply_normal(pair: &mut LanePair, p: &mut LanePoints, normal: (F64x4, F64x4), total: F64x4) {
+    let total = total.max(F64x4::splat(0.0));
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
     p.max_normal_impulse = p.max_normal_impulse.max(delta);
@@ -692,11 +692,11 @@ fn apply_normal(pair: &mut LanePair, p: &mut LanePoints, normal: (f64x4, f64x4),
 
 /// `approach` on every lane: the fastest approach of points that may bounce.
 #[inline(always)]
-fn approach(p: &mut LanePoints, vn: f64x4, separation: f64x4) {
-    let zero = f64x4::splat(0.0);
+fn approach(p: &mut LanePoints, vn: F64x4, separation: F64x4) {
+    let zero = F64x4::splat(0.0);
     let may_bounce = p.restitution.ne(zero) & p.max_normal_impulse.eq(zero) & vn.lt(zero);
     if may_bounce.any() {
-        let gained = f64x4::splat(2.0) * p.closing_acceleration * separation.max(zero);
+        let gained = F64x4::splat(2.0) * p.closing_acceleration * separation.max(zero);
         let impact = -(vn * vn + gained.max(zero)).sqrt();
         p.relative_velocity =
             may_bounce.select(p.relative_velocity.min(impact), p.relative_velocity);

@@ -1,5 +1,5 @@
 //! Four f64 lanes, written as plain arrays so that the compiler vectorises them: with
-//! AVX2 (chosen at run time, see `lanes::solve_batch`) each operation is one 256-bit
+//! AVX2 (chosen at run time, see `ManifoldBatch::solve`) each operation is one 256-bit
 //! instruction; without, two SSE2 ones. Every lane rounds as the scalar code does, so
 //! both paths give the same bits.
 
