@@ -878,8 +878,9 @@ fn solve_pair(
 /// one spring per point (S = diag K) where k₁₂ ≥ 0, coupled springs (S = K) where k₁₂ < 0.
 /// Coupled everywhere, the 20-, 40- and 100-row pyramids sank 0.048, 0.19 and 1.15 boxes;
 /// one per point everywhere, the stacks of 10 and 20 sank 0.035 and 0.14 instead of
-/// 0.028 and 0.11. As now: pyramids 0.032, 0.12 and 0.88 (Box2D v3, point by point:
-/// 0.03, 0.12 and 0.91), stacks 0.028 and 0.11 (Box2D v3 0.034; rapier2d 0.032, 0.135).
+/// 0.028 and 0.11. As now, in the points' order: pyramids 0.032, 0.12 and 0.88 (Box2D v3,
+/// point by point: 0.03, 0.12 and 0.91; solved by colours, see `batch`, the 100-row one
+/// sinks 1.00), stacks 0.028 and 0.11 (Box2D v3 0.034; rapier2d 0.032, 0.135).
 #[inline(always)]
 fn solve_normal_pair(
     pair: &mut BodyPair,

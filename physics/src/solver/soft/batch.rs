@@ -1,5 +1,5 @@
-//! The passes' order over a step's manifolds, and four two-point manifolds solved side
-//! by side, one per SIMD lane, as Box2D v3 does.
+//! The passes' order over a step's manifolds, and four manifolds solved side by side,
+//! one per SIMD lane, as Box2D v3 does.
 //!
 //! Manifolds of a big island are grouped by colours of the constraint graph (no two in a
 //! colour share a moving body), as Box2D v3 assigns them: manifolds between two moving
@@ -14,20 +14,21 @@
 //!
 //! Against the points' order (by body pair: a pile's bottom row first), colours stand the
 //! 20- and 40-row pyramids stiller (top drift 0.0023 and 0.0018 of a box after 500 steps,
-//! against 0.0036 and 0.016) but the 100-row one less still (largest drift 29% of a box,
-//! against 12%; Box2D v3 0.4%).
+//! against 0.0036 and 0.016) but the 100-row one less still (largest drift 36% of a box,
+//! against 12%; Box2D v3 0.4%), and without manifold reuse 1,038 of its boxes fall (none
+//! in the points' order): see docs/bench/profile.md.
 
 use super::f64x4::{F64x4, Mask4};
 use super::{PointConstraint, SoftBody, Softness};
 
 const LANES: usize = 4;
 
-/// Colours of the constraint graph (Box2D v3's count); a manifold that finds none free is
-/// solved before the colours, one at a time.
+/// Colours of the constraint graph (Box2D v3's count, whose last is its overflow; here a
+/// manifold that finds no free colour is solved before the colours, one at a time).
 const COLOURS: u32 = 24;
 
-/// Colours open to manifolds between two moving bodies: the last four are kept for those
-/// against a fixed body (Box2D v3's split).
+/// Colours 0–19 are open to manifolds between two moving bodies; those against a fixed
+/// body take 22 down to 1 (Box2D v3's split), so 20–22 are theirs alone.
 const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 
 /// Islands of fewer contact points than this are solved in the points' order, one
@@ -373,7 +374,7 @@ impl LanePair {
     }
 }
 
-/// The softness scales and targets of one pass, lane by lane.
+/// What one pass needs to find each point's target and softness (see `normal_target`).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct PassSettings {
     pub inv_h: f64,
@@ -577,9 +578,7 @@ impl<const N: usize> ManifoldBatch<N> {
         for p in &mut self.points {
             let vt = pair.velocity_along(tangent, p.tangent_lever_a, p.tangent_lever_b);
             let limit = self.friction * p.normal_impulse;
-            let total = (p.tangent_impulse - p.tangent_mass * vt)
-                .max(-limit)
-                .min(limit);
+            let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
             let delta = total - p.tangent_impulse;
             p.tangent_impulse = total;
             pair.apply_along(tangent, p.tangent_lever_a, p.tangent_lever_b, delta);
@@ -832,7 +831,8 @@ mod tests {
     const FIRSTS: [u32; LANES] = [0, 2, 4, 6];
 
     /// Velocities and impulses: what a pass changes.
-    fn state(bodies: &[SoftBody], points: &[PointConstraint]) -> Vec<f64> {
+    /// As bits, so that even the sign of a zero counts.
+    fn state(bodies: &[SoftBody], points: &[PointConstraint]) -> Vec<u64> {
         let v = bodies.iter().flat_map(|b| [b.v.x, b.v.y, b.w]);
         let p = points.iter().flat_map(|p| {
             [
@@ -842,7 +842,7 @@ mod tests {
                 p.relative_velocity,
             ]
         });
-        v.chain(p).collect()
+        v.chain(p).map(f64::to_bits).collect()
     }
 
     /// Solves the manifolds starting at `firsts` as one batch, through `solve` (AVX2
@@ -853,7 +853,7 @@ mod tests {
         (bodies, points): (&[SoftBody], &[PointConstraint]),
         firsts: [u32; LANES],
         pass: &PassSettings,
-        expected: &[f64],
+        expected: &[u64],
         label: &str,
     ) {
         for dispatched in [true, false] {
@@ -928,11 +928,13 @@ mod tests {
             for p in &points {
                 warm_start_point(&mut one_by_one, p);
             }
-            let mut lanes = bodies.clone();
             let mut batch = ManifoldBatch::<2>::default();
             batch.fill(FIRSTS, &points, &bodies);
+            let (mut lanes, mut generic) = (bodies.clone(), bodies.clone());
             batch.warm_start(&mut lanes);
+            batch.warm_start_lanes(&mut generic);
             assert_eq!(state(&lanes, &[]), state(&one_by_one, &[]), "seed {seed}");
+            assert_eq!(state(&generic, &[]), state(&one_by_one, &[]), "seed {seed}");
         }
     }
 

@@ -45,6 +45,21 @@ impl F64x4 {
         self.zip(rhs, |a, b| if a < b { a } else { b })
     }
 
+    /// `f64::clamp` lane by lane, to the bit (a zero keeps its sign as there).
+    #[inline(always)]
+    pub fn clamp(self, lo: Self, hi: Self) -> Self {
+        Self::from_fn(|k| {
+            let x = self.0[k];
+            if x < lo.0[k] {
+                lo.0[k]
+            } else if x > hi.0[k] {
+                hi.0[k]
+            } else {
+                x
+            }
+        })
+    }
+
     #[inline(always)]
     pub fn sqrt(self) -> Self {
         Self::from_fn(|k| self.0[k].sqrt())
