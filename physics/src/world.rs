@@ -225,12 +225,12 @@ struct Scratch {
     boxes: Vec<Option<Aabb>>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
-    /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin`, which
-    /// bodies were fixed then, and whether they still stand (see `find_candidate_pairs`).
+    /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin`, and which
+    /// bodies were fixed then (see `find_candidate_pairs`; emptied when they no longer
+    /// stand).
     fat_boxes: Vec<Option<Aabb>>,
     fat_pairs: Vec<(u32, u32)>,
     fat_fixed: Vec<bool>,
-    fat_pairs_valid: bool,
     solver_bodies: Vec<SolverBody>,
     /// How far each body can move this step.
     reach: Vec<f64>,
@@ -433,7 +433,9 @@ impl World {
         if !std::mem::take(&mut self.collision_filter_stale) {
             return;
         }
-        self.scratch.fat_pairs_valid = false;
+        self.scratch.fat_boxes.clear();
+        self.scratch.fat_fixed.clear();
+        self.scratch.fat_pairs.clear();
         self.jointed.clear();
         self.jointed.extend(
             self.joints
@@ -1385,7 +1387,7 @@ impl World {
                 .iter()
                 .enumerate()
                 .all(|(i, &f)| f == is_fixed(i));
-        if !(s.fat_pairs_valid && still_inside && same_fixed) {
+        if !(still_inside && same_fixed) {
             let grow = self.settings.broad_phase_margin();
             s.fat_boxes.clear();
             s.fat_boxes
@@ -1398,7 +1400,6 @@ impl World {
                     && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
             };
             s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
-            s.fat_pairs_valid = true;
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
         let boxes = &s.boxes;

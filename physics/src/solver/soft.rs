@@ -100,6 +100,13 @@ struct SoftBody {
     dangle: f64,
 }
 
+impl SoftBody {
+    /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
+    fn moves(&self) -> bool {
+        self.inv_mass > 0.0 || self.inv_inertia > 0.0
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct PointConstraint {
     contact: u32,
@@ -274,12 +281,7 @@ impl SoftStepSolver {
                 j.motor_step_total += j.motor_impulse;
             }
         }
-        for batch in self.plan.batches() {
-            batch.scatter(&mut self.points);
-        }
-        for batch in self.plan.point_batches() {
-            batch.scatter(&mut self.points);
-        }
+        self.plan.scatter(&mut self.points);
         self.restitution(bounce_below);
         self.store(bodies, contacts, joints);
         self.report();
@@ -464,7 +466,7 @@ impl SoftStepSolver {
 
     fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
         for (b, (lin, ang)) in self.bodies.iter_mut().zip(accelerations) {
-            if b.inv_mass == 0.0 && b.inv_inertia == 0.0 {
+            if !b.moves() {
                 continue;
             }
             b.v += lin * h;
@@ -498,8 +500,10 @@ impl SoftStepSolver {
     }
 
     fn warm_start(&mut self) {
-        for p in self.points.iter().filter(|p| p.in_lcp) {
-            warm_start_point(&mut self.bodies, p);
+        for &(start, end, _) in &self.contact_lcp.islands {
+            for p in &self.points[start..end] {
+                warm_start_point(&mut self.bodies, p);
+            }
         }
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         for item in &self.plan.items {
@@ -628,7 +632,7 @@ impl SoftStepSolver {
         joints: &mut [JointConstraint],
     ) {
         for (b, s) in bodies.iter_mut().zip(&self.bodies) {
-            if s.inv_mass == 0.0 && s.inv_inertia == 0.0 {
+            if !s.moves() {
                 continue;
             }
             b.velocity = s.v;
@@ -942,8 +946,7 @@ fn sort_into_islands<T: Copy>(
     (uf, grouped): (&mut UnionFind, &mut Vec<(u32, u32)>),
     ranges: &mut Vec<(usize, usize)>,
 ) {
-    let dynamic =
-        |i: u32| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0;
+    let dynamic = |i: u32| bodies[i as usize].moves();
     group_by_island(
         items.len(),
         bodies.len(),
@@ -1085,7 +1088,7 @@ fn coupling(
     for (bp, sp, rp) in [(p.a, 1.0, pa), (p.b, -1.0, pb)] {
         for (bq, sq, rq) in [(q.a, 1.0, qa), (q.b, -1.0, qb)] {
             let body = &bodies[bp as usize];
-            if bp != bq || (body.inv_mass == 0.0 && body.inv_inertia == 0.0) {
+            if bp != bq || !body.moves() {
                 continue;
             }
             let (m, i) = (body.inv_mass, body.inv_inertia);

@@ -50,12 +50,9 @@ pub(super) enum PassItem {
 #[derive(Debug, Clone, Default)]
 pub(super) struct PassPlan {
     pub items: Vec<PassItem>,
-    /// The step's batches are the first `batch_count` (of two-point manifolds) and
-    /// `point_batch_count` (one-point); the rest are kept to be refilled.
-    batches: Vec<ManifoldBatch<2>>,
-    batch_count: usize,
-    point_batches: Vec<ManifoldBatch<1>>,
-    point_batch_count: usize,
+    /// Batches of two-point and of one-point manifolds.
+    pairs: BatchPool<2>,
+    singles: BatchPool<1>,
     /// Per body, a bit for each colour it already has a manifold in.
     colours_of: Vec<u32>,
     /// `(colour, first point, point count)` of the coloured manifolds.
@@ -72,8 +69,8 @@ impl PassPlan {
         bodies: &[SoftBody],
     ) {
         self.items.clear();
-        self.batch_count = 0;
-        self.point_batch_count = 0;
+        self.pairs.clear();
+        self.singles.clear();
         self.coloured.clear();
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
@@ -101,52 +98,42 @@ impl PassPlan {
         // A stable sort: each colour keeps the points' order.
         self.coloured.sort_by_key(|c| c.0);
         // Two-point and one-point manifolds fill their own batches, colour by colour.
-        let (mut pairs, mut singles) = ([0; LANES], [0; LANES]);
-        let (mut pairs_filled, mut singles_filled) = (0, 0);
         let mut i = 0;
         while i < self.coloured.len() {
             let colour = self.coloured[i].0;
             while i < self.coloured.len() && self.coloured[i].0 == colour {
                 let (_, first, count) = self.coloured[i];
                 i += 1;
-                if colour == 0 {
-                    self.items.push(PassItem::Manifold(first, count));
-                } else if count == 2 {
-                    pairs[pairs_filled] = first;
-                    pairs_filled += 1;
-                    if pairs_filled == LANES {
-                        self.add_batch(pairs, points, bodies);
-                        pairs_filled = 0;
-                    }
-                } else {
-                    singles[singles_filled] = first;
-                    singles_filled += 1;
-                    if singles_filled == LANES {
-                        self.add_point_batch(singles, points, bodies);
-                        singles_filled = 0;
-                    }
+                let items = &mut self.items;
+                match (colour, count) {
+                    (0, _) => items.push(PassItem::Manifold(first, count)),
+                    (_, 2) => self.pairs.take(first, (points, bodies), items),
+                    _ => self.singles.take(first, (points, bodies), items),
                 }
             }
-            let rest = pairs[..pairs_filled]
-                .iter()
-                .map(|&f| PassItem::Manifold(f, 2));
-            self.items.extend(rest);
-            let rest = singles[..singles_filled]
-                .iter()
-                .map(|&f| PassItem::Manifold(f, 1));
-            self.items.extend(rest);
-            (pairs_filled, singles_filled) = (0, 0);
+            self.pairs.end_colour(&mut self.items);
+            self.singles.end_colour(&mut self.items);
+        }
+    }
+
+    /// Writes what the passes changed in the batches back to their points.
+    pub fn scatter(&self, points: &mut [PointConstraint]) {
+        for batch in self.batches() {
+            batch.scatter(points);
+        }
+        for batch in self.point_batches() {
+            batch.scatter(points);
         }
     }
 
     /// The step's batches of two-point manifolds.
     pub fn batches(&self) -> &[ManifoldBatch<2>] {
-        &self.batches[..self.batch_count]
+        self.pairs.filled()
     }
 
     /// The step's batches of one-point manifolds.
     pub fn point_batches(&self) -> &[ManifoldBatch<1>] {
-        &self.point_batches[..self.point_batch_count]
+        self.singles.filled()
     }
 
     /// The step's work and its batches, to solve them.
@@ -159,42 +146,15 @@ impl PassPlan {
     ) {
         (
             &self.items,
-            &mut self.batches[..self.batch_count],
-            &mut self.point_batches[..self.point_batch_count],
+            self.pairs.filled_mut(),
+            self.singles.filled_mut(),
         )
-    }
-
-    fn add_batch(&mut self, firsts: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
-        if self.batch_count == self.batches.len() {
-            self.batches.push(ManifoldBatch::default());
-        }
-        self.batches[self.batch_count].fill(firsts, points, bodies);
-        self.items.push(PassItem::Batch(self.batch_count as u32));
-        self.batch_count += 1;
-    }
-
-    fn add_point_batch(
-        &mut self,
-        firsts: [u32; LANES],
-        points: &[PointConstraint],
-        bodies: &[SoftBody],
-    ) {
-        if self.point_batch_count == self.point_batches.len() {
-            self.point_batches.push(ManifoldBatch::default());
-        }
-        self.point_batches[self.point_batch_count].fill(firsts, points, bodies);
-        self.items
-            .push(PassItem::PointBatch(self.point_batch_count as u32));
-        self.point_batch_count += 1;
     }
 
     /// A manifold's colour, counted from 1 (0: none free, solved first), marking it taken
     /// for its moving bodies.
     fn colour_of(&mut self, p: &PointConstraint, bodies: &[SoftBody]) -> u32 {
-        let moving = |i: u32| {
-            let b = &bodies[i as usize];
-            b.inv_mass > 0.0 || b.inv_inertia > 0.0
-        };
+        let moving = |i: u32| bodies[i as usize].moves();
         let (a, b) = (p.a as usize, p.b as usize);
         let free = match (moving(p.a), moving(p.b)) {
             (true, true) => {
@@ -218,6 +178,66 @@ impl PassPlan {
     /// in Box2D v3).
     fn last_free(used: u32) -> Option<u32> {
         (1..COLOURS - 1).rev().find(|&c| used & (1 << c) == 0)
+    }
+}
+
+/// Batches of `N`-point manifolds being filled for one step: the step's are the first
+/// `filled`, the rest kept (with their allocation) to be refilled next step.
+#[derive(Debug, Clone, Default)]
+struct BatchPool<const N: usize> {
+    batches: Vec<ManifoldBatch<N>>,
+    filled: usize,
+    /// First points of the colour's manifolds waiting for a full batch.
+    waiting: [u32; LANES],
+    waiting_len: usize,
+}
+
+impl<const N: usize> BatchPool<N> {
+    fn clear(&mut self) {
+        self.filled = 0;
+        self.waiting_len = 0;
+    }
+
+    fn filled(&self) -> &[ManifoldBatch<N>] {
+        &self.batches[..self.filled]
+    }
+
+    fn filled_mut(&mut self) -> &mut [ManifoldBatch<N>] {
+        &mut self.batches[..self.filled]
+    }
+
+    /// Takes the manifold at `first` into the colour's next batch, which goes into
+    /// `items` once it holds four.
+    fn take(
+        &mut self,
+        first: u32,
+        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        items: &mut Vec<PassItem>,
+    ) {
+        self.waiting[self.waiting_len] = first;
+        self.waiting_len += 1;
+        if self.waiting_len < LANES {
+            return;
+        }
+        self.waiting_len = 0;
+        if self.filled == self.batches.len() {
+            self.batches.push(ManifoldBatch::default());
+        }
+        self.batches[self.filled].fill(self.waiting, points, bodies);
+        let k = self.filled as u32;
+        items.push(if N == 2 {
+            PassItem::Batch(k)
+        } else {
+            PassItem::PointBatch(k)
+        });
+        self.filled += 1;
+    }
+
+    /// At the end of a colour, the manifolds short of a batch go into `items` one by one.
+    fn end_colour(&mut self, items: &mut Vec<PassItem>) {
+        let alone = self.waiting[..self.waiting_len].iter();
+        items.extend(alone.map(|&f| PassItem::Manifold(f, N as u32)));
+        self.waiting_len = 0;
     }
 }
 
@@ -288,10 +308,6 @@ impl<const N: usize> Default for ManifoldBatch<N> {
     }
 }
 
-fn lanes(f: impl Fn(usize) -> f64) -> F64x4 {
-    F64x4::from_fn(f)
-}
-
 /// A body's velocity, lane by lane.
 #[derive(Debug, Clone, Copy)]
 struct LaneVelocity {
@@ -305,9 +321,9 @@ impl LaneVelocity {
     fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
         let body = |k: usize| &bodies[index[k] as usize];
         Self {
-            x: lanes(|k| body(k).v.x),
-            y: lanes(|k| body(k).v.y),
-            w: lanes(|k| body(k).w),
+            x: F64x4::from_fn(|k| body(k).v.x),
+            y: F64x4::from_fn(|k| body(k).v.y),
+            w: F64x4::from_fn(|k| body(k).w),
         }
     }
 
@@ -517,10 +533,16 @@ impl<const N: usize> ManifoldBatch<N> {
     fn separations(&self, bodies: &[SoftBody]) -> [F64x4; N] {
         let a = |k: usize| &bodies[self.a[k] as usize];
         let b = |k: usize| &bodies[self.b[k] as usize];
-        let dx = lanes(|k| a(k).dp.x - b(k).dp.x);
-        let dy = lanes(|k| a(k).dp.y - b(k).dp.y);
-        let (cos_a, sin_a) = (lanes(|k| a(k).dq.cos), lanes(|k| a(k).dq.sin));
-        let (cos_b, sin_b) = (lanes(|k| b(k).dq.cos), lanes(|k| b(k).dq.sin));
+        let dx = F64x4::from_fn(|k| a(k).dp.x - b(k).dp.x);
+        let dy = F64x4::from_fn(|k| a(k).dp.y - b(k).dp.y);
+        let (cos_a, sin_a) = (
+            F64x4::from_fn(|k| a(k).dq.cos),
+            F64x4::from_fn(|k| a(k).dq.sin),
+        );
+        let (cos_b, sin_b) = (
+            F64x4::from_fn(|k| b(k).dq.cos),
+            F64x4::from_fn(|k| b(k).dq.sin),
+        );
         let one = F64x4::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
         let separation = |p: &LanePoints| {
