@@ -9,9 +9,11 @@ use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 #[repr(C, align(32))]
 pub(super) struct F64x4(pub [f64; 4]);
 
-/// A lane-wise condition.
+/// A lane-wise condition, each lane all ones or all zeros as a vector comparison leaves
+/// it, so that choosing by it is one blend (a `bool` per lane cost conversions both ways).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Mask4([bool; 4]);
+#[repr(C, align(32))]
+pub(super) struct Mask4([u64; 4]);
 
 impl F64x4 {
     #[inline(always)]
@@ -31,7 +33,9 @@ impl F64x4 {
 
     #[inline(always)]
     fn compare(self, rhs: Self, f: impl Fn(f64, f64) -> bool) -> Mask4 {
-        Mask4(std::array::from_fn(|k| f(self.0[k], rhs.0[k])))
+        Mask4(std::array::from_fn(|k| {
+            if f(self.0[k], rhs.0[k]) { u64::MAX } else { 0 }
+        }))
     }
 
     /// The larger of each pair (for numbers; no NaN reaches the solver).
@@ -45,19 +49,13 @@ impl F64x4 {
         self.zip(rhs, |a, b| if a < b { a } else { b })
     }
 
-    /// `f64::clamp` lane by lane, to the bit (a zero keeps its sign as there).
+    /// `f64::clamp` lane by lane, to the bit (a zero keeps its sign as there), for
+    /// `lo <= hi`: the upper bound where `hi < x`, then the lower where `lo > ` that, which
+    /// are one `minpd` and one `maxpd`.
     #[inline(always)]
     pub fn clamp(self, lo: Self, hi: Self) -> Self {
-        Self::from_fn(|k| {
-            let x = self.0[k];
-            if x < lo.0[k] {
-                lo.0[k]
-            } else if x > hi.0[k] {
-                hi.0[k]
-            } else {
-                x
-            }
-        })
+        let below_hi = hi.zip(self, |hi, x| if hi < x { hi } else { x });
+        lo.zip(below_hi, |lo, t| if lo > t { lo } else { t })
     }
 
     #[inline(always)]
@@ -94,18 +92,15 @@ impl F64x4 {
 impl Mask4 {
     #[inline(always)]
     pub fn any(self) -> bool {
-        self.0.iter().any(|&m| m)
+        self.0.iter().fold(0, |any, &m| any | m) != 0
     }
 
-    /// `if_true` where the condition holds, `if_false` elsewhere.
+    /// `if_true` where the condition holds, `if_false` elsewhere (bit for bit).
     #[inline(always)]
     pub fn select(self, if_true: F64x4, if_false: F64x4) -> F64x4 {
         F64x4::from_fn(|k| {
-            if self.0[k] {
-                if_true.0[k]
-            } else {
-                if_false.0[k]
-            }
+            let m = self.0[k];
+            f64::from_bits((if_true.0[k].to_bits() & m) | (if_false.0[k].to_bits() & !m))
         })
     }
 }
