@@ -115,6 +115,10 @@ fn main() {
         run_pe_alone();
         return;
     }
+    if std::env::args().nth(1).as_deref() == Some("pile") {
+        run_pile_with_peers();
+        return;
+    }
     let mut rows = Vec::new();
     for spec in &PYRAMIDS {
         rows.push(run_row(
@@ -194,6 +198,39 @@ fn run_pe_alone() {
         std::process::exit(2);
     };
     println!("{scene} under pe {}: {outcome:?}", solver.name());
+}
+
+/// `pile <pyramid scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile, taking
+/// turns for a few rounds so that all three see the machine in the same states, printing
+/// each round's medians and the ratios (a quick check while working on the soft step).
+fn run_pile_with_peers() {
+    let scene = std::env::args().nth(2).unwrap_or_else(|| "pyramid20".into());
+    let rounds: usize = std::env::args()
+        .nth(3)
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(3);
+    let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) else {
+        let names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
+        eprintln!("unknown pile {scene:?}: one of {}", names.join(", "));
+        std::process::exit(2);
+    };
+    for round in 1..=rounds {
+        let pe = pe_scenes::pyramid(PeConfig::new(ContactSolver::Soft), spec, H);
+        let rapier = rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS);
+        let box2d = box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS);
+        println!(
+            "{scene} round {round}: pe soft {} ({}), rapier2d {} ({}), Box2D v3 {} ({}); \
+             pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
+            pretty(pe.timing.median),
+            pe.metric,
+            pretty(rapier.timing.median),
+            rapier.metric,
+            pretty(box2d.timing.median),
+            box2d.metric,
+            ratio(pe.timing.median, rapier.timing.median),
+            ratio(pe.timing.median, box2d.timing.median),
+        );
+    }
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
