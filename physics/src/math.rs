@@ -21,8 +21,10 @@ pub fn cross_scalar(omega: f64, r: Vec2) -> Vec2 {
     Vec2::new(-omega * r.y, omega * r.x)
 }
 
-/// A rotation by an angle, stored as its cosine and sine.
+/// A rotation by an angle, stored as its cosine and sine (in that order: the soft step
+/// reads them as a pair).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(C)]
 pub struct Rot {
     pub cos: f64,
     pub sin: f64,

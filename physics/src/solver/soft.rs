@@ -15,8 +15,11 @@ use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use batch::{PassItem, PassPlan, PassSettings};
+use f64x4::BodyRow;
 use nalgebra::{DMatrix, DVector};
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 mod batch;
 mod f64x4;
 
@@ -88,19 +91,53 @@ impl Softness {
 }
 
 /// A body during the soft step: velocity, inverse mass, and how far it moved this step.
+///
+/// Laid out for the batches' AVX2 path (`avx2::F64x4Avx2::gather`), which reads four
+/// bodies' `v, w, inv_mass` as one 32-byte row each and `dp, dq` as another, and
+/// transposes them into lanes: the two rows start at 0 and 32 bytes, and a body is
+/// 32-byte aligned.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C, align(32))]
 struct SoftBody {
     v: Vec2,
     w: f64,
     inv_mass: f64,
-    inv_inertia: f64,
     /// Displacement and rotation since the start of the step.
     dp: Vec2,
     dq: Rot,
+    inv_inertia: f64,
     dangle: f64,
 }
 
+// The rows `SoftBody::row_offset` names.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    assert!(size_of::<Vec2>() == 16 && size_of::<Rot>() == 16);
+    assert!(offset_of!(SoftBody, v) == 0 && offset_of!(SoftBody, w) == 16);
+    assert!(offset_of!(SoftBody, inv_mass) == 24);
+    assert!(offset_of!(SoftBody, dp) == 32 && offset_of!(SoftBody, dq) == 48);
+    assert!(offset_of!(Rot, cos) == 0 && offset_of!(Rot, sin) == 8);
+};
+
 impl SoftBody {
+    /// The four numbers of `row`, in its order.
+    fn row(&self, row: BodyRow) -> [f64; 4] {
+        match row {
+            BodyRow::Velocity => [self.v.x, self.v.y, self.w, self.inv_mass],
+            BodyRow::Motion => [self.dp.x, self.dp.y, self.dq.cos, self.dq.sin],
+        }
+    }
+
+    /// Where `row` starts, in f64s from the start of the body (the layout asserted below
+    /// the struct).
+    #[cfg(target_arch = "x86_64")]
+    const fn row_offset(row: BodyRow) -> usize {
+        match row {
+            BodyRow::Velocity => 0,
+            BodyRow::Motion => 4,
+        }
+    }
+
     /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
     fn moves(&self) -> bool {
         self.inv_mass > 0.0 || self.inv_inertia > 0.0

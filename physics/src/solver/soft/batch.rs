@@ -18,7 +18,9 @@
 //! against 12%; Box2D v3 0.4%), and without manifold reuse 1,038 of its boxes fall (none
 //! in the points' order): see docs/bench/profile.md.
 
-use super::f64x4::{F64x4, Mask4};
+#[cfg(target_arch = "x86_64")]
+use super::avx2::F64x4Avx2;
+use super::f64x4::{BodyRow, F64x4, LaneMask, Lanes};
 use super::{PointConstraint, SoftBody, Softness};
 
 const LANES: usize = 4;
@@ -243,47 +245,58 @@ impl<const N: usize> BatchPool<N> {
 
 /// One point of each lane's manifold.
 #[derive(Debug, Clone, Copy, Default)]
-struct LanePoints {
-    normal_lever_a: F64x4,
-    normal_lever_b: F64x4,
-    tangent_lever_a: F64x4,
-    tangent_lever_b: F64x4,
-    reach_a: F64x4,
-    reach_b: F64x4,
-    base_separation: F64x4,
-    normal_mass: F64x4,
-    tangent_mass: F64x4,
-    restitution: F64x4,
-    relative_velocity: F64x4,
-    normal_impulse: F64x4,
-    tangent_impulse: F64x4,
-    max_normal_impulse: F64x4,
-    closing_acceleration: F64x4,
+#[repr(C)]
+struct LanePoints<L = F64x4> {
+    normal_lever_a: L,
+    normal_lever_b: L,
+    tangent_lever_a: L,
+    tangent_lever_b: L,
+    reach_a: L,
+    reach_b: L,
+    base_separation: L,
+    normal_mass: L,
+    tangent_mass: L,
+    restitution: L,
+    relative_velocity: L,
+    normal_impulse: L,
+    tangent_impulse: L,
+    max_normal_impulse: L,
+    closing_acceleration: L,
 }
 
 /// Four manifolds of `N` points (one or two) with no moving body in common, their data
 /// lane by lane; each manifold's points stay in `points` too, which this batch updates at
-/// the end of the substeps.
+/// the end of the substeps. Stored with `F64x4` lanes; `repr(C)`, so that the AVX2 path
+/// reads the same bytes as `ManifoldBatch<N, F64x4Avx2>`.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct ManifoldBatch<const N: usize> {
+#[repr(C)]
+pub(super) struct ManifoldBatch<const N: usize, L = F64x4> {
     /// The first of each lane's points in `points`.
     first_point: [u32; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
-    inv_mass_a: F64x4,
-    inv_mass_b: F64x4,
-    inv_inertia_a: F64x4,
-    inv_inertia_b: F64x4,
-    normal_x: F64x4,
-    normal_y: F64x4,
-    friction: F64x4,
-    k11: F64x4,
-    k12: F64x4,
-    k22: F64x4,
-    /// The 2 × 2 block (two-point manifolds only).
-    inverse: (F64x4, F64x4, F64x4),
-    points: [LanePoints; N],
+    inv_mass_a: L,
+    inv_mass_b: L,
+    inv_inertia_a: L,
+    inv_inertia_b: L,
+    normal_x: L,
+    normal_y: L,
+    friction: L,
+    k11: L,
+    k12: L,
+    k22: L,
+    /// The inverse of the 2 × 2 block, `[i11, i12, i22]` (two-point manifolds only).
+    inverse: [L; 3],
+    points: [LanePoints<L>; N],
 }
+
+#[cfg(target_arch = "x86_64")]
+const _: () = {
+    use std::mem::{align_of, size_of};
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x4Avx2>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x4Avx2>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x4Avx2>>());
+};
 
 impl<const N: usize> Default for ManifoldBatch<N> {
     fn default() -> Self {
@@ -302,7 +315,7 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             k11: zero,
             k12: zero,
             k22: zero,
-            inverse: (zero, zero, zero),
+            inverse: [zero; 3],
             points: [LanePoints::default(); N],
         }
     }
@@ -310,52 +323,46 @@ impl<const N: usize> Default for ManifoldBatch<N> {
 
 /// A body's velocity, lane by lane.
 #[derive(Debug, Clone, Copy)]
-struct LaneVelocity {
-    x: F64x4,
-    y: F64x4,
-    w: F64x4,
+struct LaneVelocity<L> {
+    x: L,
+    y: L,
+    w: L,
+    /// The inverse masses read with the velocities (`BodyRow::Velocity`), which
+    /// `scatter_velocities` may write back beside them.
+    inv_mass: L,
 }
 
-impl LaneVelocity {
+impl<L: Lanes> LaneVelocity<L> {
     #[inline(always)]
     fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
-        let body = |k: usize| &bodies[index[k] as usize];
-        Self {
-            x: F64x4::from_fn(|k| body(k).v.x),
-            y: F64x4::from_fn(|k| body(k).v.y),
-            w: F64x4::from_fn(|k| body(k).w),
-        }
+        let [x, y, w, inv_mass] = L::gather(bodies, index, BodyRow::Velocity);
+        Self { x, y, w, inv_mass }
     }
 
     #[inline(always)]
     fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
-        let (x, y, w) = (self.x.0, self.y.0, self.w.0);
-        for k in 0..LANES {
-            let body = &mut bodies[index[k] as usize];
-            body.v.x = x[k];
-            body.v.y = y[k];
-            body.w = w[k];
-        }
+        L::scatter_velocities([self.x, self.y, self.w, self.inv_mass], bodies, index);
     }
 }
 
 /// The two bodies' velocities and inverse masses of every lane, as `BodyPair`.
 #[derive(Debug, Clone, Copy)]
-struct LanePair {
-    a: LaneVelocity,
-    b: LaneVelocity,
-    inv_mass: (F64x4, F64x4),
-    inv_inertia: (F64x4, F64x4),
+struct LanePair<L> {
+    a: LaneVelocity<L>,
+    b: LaneVelocity<L>,
+    inv_mass: (L, L),
+    inv_inertia: (L, L),
 }
 
-impl LanePair {
+impl<L: Lanes> LanePair<L> {
     /// `if_true`'s velocities where `mask` holds, `if_false`'s elsewhere.
     #[inline(always)]
-    fn select(mask: Mask4, if_true: Self, if_false: Self) -> Self {
-        let pick = |t: LaneVelocity, f: LaneVelocity| LaneVelocity {
+    fn select(mask: L::Mask, if_true: Self, if_false: Self) -> Self {
+        let pick = |t: LaneVelocity<L>, f: LaneVelocity<L>| LaneVelocity {
             x: mask.select(t.x, f.x),
             y: mask.select(t.y, f.y),
             w: mask.select(t.w, f.w),
+            inv_mass: f.inv_mass,
         };
         Self {
             a: pick(if_true.a, if_false.a),
@@ -366,20 +373,14 @@ impl LanePair {
 
     /// `BodyPair::velocity_along`, lane by lane.
     #[inline(always)]
-    fn velocity_along(&self, (dx, dy): (F64x4, F64x4), lever_a: F64x4, lever_b: F64x4) -> F64x4 {
+    fn velocity_along(&self, (dx, dy): (L, L), lever_a: L, lever_b: L) -> L {
         let (rx, ry) = (self.a.x - self.b.x, self.a.y - self.b.y);
         rx * dx + ry * dy + self.a.w * lever_a - self.b.w * lever_b
     }
 
     /// `BodyPair::apply_along`, lane by lane.
     #[inline(always)]
-    fn apply_along(
-        &mut self,
-        (dx, dy): (F64x4, F64x4),
-        lever_a: F64x4,
-        lever_b: F64x4,
-        impulse: F64x4,
-    ) {
+    fn apply_along(&mut self, (dx, dy): (L, L), lever_a: L, lever_b: L, impulse: L) {
         let (sa, sb) = (impulse * self.inv_mass.0, impulse * self.inv_mass.1);
         self.a.x += dx * sa;
         self.a.y += dy * sa;
@@ -420,17 +421,33 @@ impl<const N: usize> ManifoldBatch<N> {
         self.solve_lanes(bodies, pass)
     }
 
+    /// The batch as AVX2 registers: the same bytes (`repr(C)`, lanes of one size and
+    /// alignment, asserted above; any bits are valid in either).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn as_avx2(&self) -> &ManifoldBatch<N, F64x4Avx2> {
+        // SAFETY: see above; the borrow is `self`'s.
+        unsafe { &*(self as *const Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn as_avx2_mut(&mut self) -> &mut ManifoldBatch<N, F64x4Avx2> {
+        // SAFETY: as `as_avx2`.
+        unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
+    }
+
     /// The same code compiled for AVX2, whose 256-bit registers hold the four lanes.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        self.warm_start_lanes(bodies)
+        self.as_avx2().warm_start_lanes(bodies)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        self.solve_lanes(bodies, pass)
+        self.as_avx2_mut().solve_lanes(bodies, pass)
     }
 
     /// Fills the batch with the manifolds whose first points are `first_point`.
@@ -453,9 +470,9 @@ impl<const N: usize> ManifoldBatch<N> {
                 self.k11.0[k] = block.k11;
                 self.k12.0[k] = block.k12;
                 self.k22.0[k] = block.k22;
-                self.inverse.0.0[k] = block.inverse.0;
-                self.inverse.1.0[k] = block.inverse.1;
-                self.inverse.2.0[k] = block.inverse.2;
+                self.inverse[0].0[k] = block.inverse.0;
+                self.inverse[1].0[k] = block.inverse.1;
+                self.inverse[2].0[k] = block.inverse.2;
             }
             for (lane, p) in self.points.iter_mut().zip(&points[first as usize..]) {
                 lane.normal_lever_a.0[k] = p.levers.normal.0;
@@ -493,9 +510,11 @@ impl<const N: usize> ManifoldBatch<N> {
             }
         }
     }
+}
 
+impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     #[inline(always)]
-    fn load(&self, bodies: &[SoftBody]) -> LanePair {
+    fn load(&self, bodies: &[SoftBody]) -> LanePair<L> {
         LanePair {
             a: LaneVelocity::load(bodies, &self.a),
             b: LaneVelocity::load(bodies, &self.b),
@@ -504,8 +523,9 @@ impl<const N: usize> ManifoldBatch<N> {
         }
     }
 
+    /// A's lanes, then B's, as `BodyPair::store` writes them.
     #[inline(always)]
-    fn store(&self, pair: &LanePair, bodies: &mut [SoftBody]) {
+    fn store(&self, pair: &LanePair<L>, bodies: &mut [SoftBody]) {
         pair.a.store(bodies, &self.a);
         pair.b.store(bodies, &self.b);
     }
@@ -530,28 +550,19 @@ impl<const N: usize> ManifoldBatch<N> {
 
     /// `separation` for each lane's point `which`.
     #[inline(always)]
-    fn separations(&self, bodies: &[SoftBody]) -> [F64x4; N] {
-        let a = |k: usize| &bodies[self.a[k] as usize];
-        let b = |k: usize| &bodies[self.b[k] as usize];
-        let dx = F64x4::from_fn(|k| a(k).dp.x - b(k).dp.x);
-        let dy = F64x4::from_fn(|k| a(k).dp.y - b(k).dp.y);
-        let (cos_a, sin_a) = (
-            F64x4::from_fn(|k| a(k).dq.cos),
-            F64x4::from_fn(|k| a(k).dq.sin),
-        );
-        let (cos_b, sin_b) = (
-            F64x4::from_fn(|k| b(k).dq.cos),
-            F64x4::from_fn(|k| b(k).dq.sin),
-        );
-        let one = F64x4::splat(1.0);
+    fn separations(&self, bodies: &[SoftBody]) -> [L; N] {
+        let [dpx_a, dpy_a, cos_a, sin_a] = L::gather(bodies, &self.a, BodyRow::Motion);
+        let [dpx_b, dpy_b, cos_b, sin_b] = L::gather(bodies, &self.b, BodyRow::Motion);
+        let (dx, dy) = (dpx_a - dpx_b, dpy_a - dpy_b);
+        let one = L::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
-        let separation = |p: &LanePoints| {
+        let separation = |p: &LanePoints<L>| {
             let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
             let turned_b = (cos_b - one) * p.reach_b + sin_b * p.normal_lever_b;
             moved + turned_a - turned_b + p.base_separation
         };
         // A loop, not `array::from_fn`, whose closure the compiler left out of line.
-        let mut separations = [F64x4::default(); N];
+        let mut separations = [L::splat(0.0); N];
         for (s, p) in separations.iter_mut().zip(&self.points) {
             *s = separation(p);
         }
@@ -564,25 +575,24 @@ impl<const N: usize> ManifoldBatch<N> {
         let separations = self.separations(bodies);
         let mut pair = self.load(bodies);
         let normal = (self.normal_x, self.normal_y);
-        let zero = F64x4::splat(0.0);
-        let one = F64x4::splat(1.0);
+        let zero = L::splat(0.0);
+        let one = L::splat(1.0);
         // `normal_target`: speculative points close their gap, touching ones are soft
         // with bias (or rigid in the relax pass).
-        let target = |s: F64x4| {
+        let target = |s: L| {
             let speculative = s.gt(zero);
             let (target, mass_scale, impulse_scale) = if pass.use_bias {
-                let bias =
-                    -(F64x4::splat(pass.soft.bias_rate) * s).max(F64x4::splat(-pass.max_push));
+                let bias = -(L::splat(pass.soft.bias_rate) * s).max(L::splat(-pass.max_push));
                 (
                     bias,
-                    F64x4::splat(pass.soft.mass_scale),
-                    F64x4::splat(pass.soft.impulse_scale),
+                    L::splat(pass.soft.mass_scale),
+                    L::splat(pass.soft.impulse_scale),
                 )
             } else {
                 (zero, one, zero)
             };
             (
-                speculative.select(-s * F64x4::splat(pass.inv_h), target),
+                speculative.select(-s * L::splat(pass.inv_h), target),
                 speculative.select(one, mass_scale),
                 speculative.select(zero, impulse_scale),
             )
@@ -614,12 +624,12 @@ impl<const N: usize> ManifoldBatch<N> {
     #[inline(always)]
     fn solve_normals_together(
         &mut self,
-        pair: &mut LanePair,
-        separations: &[F64x4],
-        targets: &[Target],
+        pair: &mut LanePair<L>,
+        separations: &[L],
+        targets: &[Target<L>],
         pass: &PassSettings,
     ) {
-        let zero = F64x4::splat(0.0);
+        let zero = L::splat(0.0);
         let normal = (self.normal_x, self.normal_y);
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
         let soft_differs =
@@ -647,18 +657,18 @@ impl<const N: usize> ManifoldBatch<N> {
     #[inline(always)]
     fn solve_block(
         &mut self,
-        pair: &mut LanePair,
-        [v1, v2]: [F64x4; 2],
-        [(t1, ms1, s1), (t2, ms2, s2)]: [Target; 2],
+        pair: &mut LanePair<L>,
+        [v1, v2]: [L; 2],
+        [(t1, ms1, s1), (t2, ms2, s2)]: [Target<L>; 2],
     ) {
-        let zero = F64x4::splat(0.0);
+        let zero = L::splat(0.0);
         let points = &self.points[..];
         let (x1, x2) = (points[0].normal_impulse, points[1].normal_impulse);
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
         let spring12 = k12.min(zero);
         let r1 = ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2);
         let r2 = ms2 * (v2 - t2) - (k12 * x1 + k22 * x2) + s2 * (spring12 * x1 + k22 * x2);
-        let (i11, i12, i22) = self.inverse;
+        let [i11, i12, i22] = self.inverse;
         let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
         let first = -r1 * points[0].normal_mass;
         let second = -r2 * points[1].normal_mass;
@@ -679,16 +689,16 @@ impl<const N: usize> ManifoldBatch<N> {
 
 /// A point's normal target, mass scale and impulse scale (see `normal_target`), lane by
 /// lane.
-type Target = (F64x4, F64x4, F64x4);
+type Target<L> = (L, L, L);
 
 /// `solve_normal` on every lane, point after point.
 #[inline(always)]
-fn solve_normals_alone(
-    pair: &mut LanePair,
-    points: &mut [LanePoints],
-    normal: (F64x4, F64x4),
-    separations: &[F64x4],
-    targets: &[Target],
+fn solve_normals_alone<L: Lanes>(
+    pair: &mut LanePair<L>,
+    points: &mut [LanePoints<L>],
+    normal: (L, L),
+    separations: &[L],
+    targets: &[Target<L>],
 ) {
     for (k, p) in points.iter_mut().enumerate() {
         let (target, mass_scale, impulse_scale) = targets[k];
@@ -703,8 +713,8 @@ fn solve_normals_alone(
 /// `apply_normal` on every lane: the accumulated normal impulse set to `total` (clamped
 /// at 0), the difference applied.
 #[inline(always)]
-fn apply_normal(pair: &mut LanePair, p: &mut LanePoints, normal: (F64x4, F64x4), total: F64x4) {
-    let total = total.max(F64x4::splat(0.0));
+fn apply_normal<L: Lanes>(pair: &mut LanePair<L>, p: &mut LanePoints<L>, normal: (L, L), total: L) {
+    let total = total.max(L::splat(0.0));
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
     p.max_normal_impulse = p.max_normal_impulse.max(delta);
@@ -713,11 +723,11 @@ fn apply_normal(pair: &mut LanePair, p: &mut LanePoints, normal: (F64x4, F64x4),
 
 /// `approach` on every lane: the fastest approach of points that may bounce.
 #[inline(always)]
-fn approach(p: &mut LanePoints, vn: F64x4, separation: F64x4) {
-    let zero = F64x4::splat(0.0);
+fn approach<L: Lanes>(p: &mut LanePoints<L>, vn: L, separation: L) {
+    let zero = L::splat(0.0);
     let may_bounce = p.restitution.ne(zero) & p.max_normal_impulse.eq(zero) & vn.lt(zero);
     if may_bounce.any() {
-        let gained = F64x4::splat(2.0) * p.closing_acceleration * separation.max(zero);
+        let gained = L::splat(2.0) * p.closing_acceleration * separation.max(zero);
         let impact = -(vn * vn + gained.max(zero)).sqrt();
         p.relative_velocity =
             may_bounce.select(p.relative_velocity.min(impact), p.relative_velocity);
@@ -852,10 +862,11 @@ mod tests {
 
     const FIRSTS: [u32; LANES] = [0, 2, 4, 6];
 
-    /// Velocities and impulses: what a pass changes.
+    /// Velocities and impulses: what a pass changes (and the inverse masses, which the
+    /// AVX2 path writes back beside the velocities).
     /// As bits, so that even the sign of a zero counts.
     fn state(bodies: &[SoftBody], points: &[PointConstraint]) -> Vec<u64> {
-        let v = bodies.iter().flat_map(|b| [b.v.x, b.v.y, b.w]);
+        let v = bodies.iter().flat_map(|b| [b.v.x, b.v.y, b.w, b.inv_mass]);
         let p = points.iter().flat_map(|p| {
             [
                 p.normal_impulse,

@@ -1,9 +1,62 @@
-//! Four f64 lanes, written as plain arrays so that the compiler vectorises them: with
-//! AVX2 (chosen at run time, see `ManifoldBatch::solve`) each operation is one 256-bit
-//! instruction; without, two SSE2 ones. Every lane rounds as the scalar code does, so
-//! both paths give the same bits.
+//! Four f64 lanes, as the batches compute with them (`Lanes`): `F64x4`, plain arrays that
+//! the compiler vectorises, on any processor; and `avx2::F64x4Avx2`, the same numbers in
+//! a 256-bit register, inside the functions compiled for AVX2 (chosen at run time, see
+//! `ManifoldBatch::solve`). Every lane rounds as the scalar code does, so both give the
+//! same bits.
 
+use super::SoftBody;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
+
+/// Four lanes of f64 and what the batches do with them. A batch is stored with
+/// `F64x4`s and read as either implementation (they share its layout).
+pub(super) trait Lanes:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+{
+    type Mask: LaneMask<Self>;
+    fn splat(x: f64) -> Self;
+    /// The larger of each pair, `if a > b { a } else { b }` (no NaN reaches the solver).
+    fn max(self, rhs: Self) -> Self;
+    /// `if a < b { a } else { b }`.
+    fn min(self, rhs: Self) -> Self;
+    /// `f64::clamp` lane by lane, to the bit (a zero keeps its sign as there), for
+    /// `lo <= hi`: the upper bound where `hi < x`, then the lower where `lo >` that.
+    fn clamp(self, lo: Self, hi: Self) -> Self;
+    fn sqrt(self) -> Self;
+    fn gt(self, rhs: Self) -> Self::Mask;
+    fn ge(self, rhs: Self) -> Self::Mask;
+    fn lt(self, rhs: Self) -> Self::Mask;
+    fn eq(self, rhs: Self) -> Self::Mask;
+    fn ne(self, rhs: Self) -> Self::Mask;
+    /// The row `row` of the four bodies `index` names, one body a lane: its four
+    /// numbers as four columns (`SoftBody::row`).
+    fn gather(bodies: &[SoftBody], index: &[u32; 4], row: BodyRow) -> [Self; 4];
+    /// Writes the velocity row's first three columns back, lane 0 first, so that a fixed
+    /// body in several lanes keeps the last lane's, as when its manifolds are solved one
+    /// after another; the fourth column must be the inverse masses `gather` read.
+    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]);
+}
+
+/// A lane-wise condition of `L`'s lanes.
+pub(super) trait LaneMask<L>: Copy + BitAnd<Output = Self> + BitXor<Output = Self> {
+    fn any(self) -> bool;
+    /// `if_true` where the condition holds, `if_false` elsewhere (bit for bit).
+    fn select(self, if_true: L, if_false: L) -> L;
+}
+
+/// Which four numbers of a body a batch reads together (`SoftBody::row`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum BodyRow {
+    /// `v.x, v.y, w, inv_mass`.
+    Velocity,
+    /// `dp.x, dp.y, dq.cos, dq.sin`.
+    Motion,
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C, align(32))]
@@ -12,15 +65,9 @@ pub(super) struct F64x4(pub [f64; 4]);
 /// A lane-wise condition, each lane all ones or all zeros as a vector comparison leaves
 /// it, so that choosing by it is one blend (a `bool` per lane cost conversions both ways).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[repr(C, align(32))]
 pub(super) struct Mask4([u64; 4]);
 
 impl F64x4 {
-    #[inline(always)]
-    pub fn splat(x: f64) -> Self {
-        Self([x; 4])
-    }
-
     #[inline(always)]
     pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
         Self(std::array::from_fn(f))
@@ -37,67 +84,87 @@ impl F64x4 {
             if f(self.0[k], rhs.0[k]) { u64::MAX } else { 0 }
         }))
     }
+}
 
-    /// The larger of each pair (for numbers; no NaN reaches the solver).
+impl Lanes for F64x4 {
+    type Mask = Mask4;
+
     #[inline(always)]
-    pub fn max(self, rhs: Self) -> Self {
+    fn splat(x: f64) -> Self {
+        Self([x; 4])
+    }
+
+    #[inline(always)]
+    fn max(self, rhs: Self) -> Self {
         self.zip(rhs, |a, b| if a > b { a } else { b })
     }
 
     #[inline(always)]
-    pub fn min(self, rhs: Self) -> Self {
+    fn min(self, rhs: Self) -> Self {
         self.zip(rhs, |a, b| if a < b { a } else { b })
     }
 
-    /// `f64::clamp` lane by lane, to the bit (a zero keeps its sign as there), for
-    /// `lo <= hi`: the upper bound where `hi < x`, then the lower where `lo > ` that, which
-    /// are one `minpd` and one `maxpd`.
     #[inline(always)]
-    pub fn clamp(self, lo: Self, hi: Self) -> Self {
+    fn clamp(self, lo: Self, hi: Self) -> Self {
         let below_hi = hi.zip(self, |hi, x| if hi < x { hi } else { x });
         lo.zip(below_hi, |lo, t| if lo > t { lo } else { t })
     }
 
     #[inline(always)]
-    pub fn sqrt(self) -> Self {
+    fn sqrt(self) -> Self {
         Self::from_fn(|k| self.0[k].sqrt())
     }
 
     #[inline(always)]
-    pub fn gt(self, rhs: Self) -> Mask4 {
+    fn gt(self, rhs: Self) -> Mask4 {
         self.compare(rhs, |a, b| a > b)
     }
 
     #[inline(always)]
-    pub fn ge(self, rhs: Self) -> Mask4 {
+    fn ge(self, rhs: Self) -> Mask4 {
         self.compare(rhs, |a, b| a >= b)
     }
 
     #[inline(always)]
-    pub fn lt(self, rhs: Self) -> Mask4 {
+    fn lt(self, rhs: Self) -> Mask4 {
         self.compare(rhs, |a, b| a < b)
     }
 
     #[inline(always)]
-    pub fn eq(self, rhs: Self) -> Mask4 {
+    fn eq(self, rhs: Self) -> Mask4 {
         self.compare(rhs, |a, b| a == b)
     }
 
     #[inline(always)]
-    pub fn ne(self, rhs: Self) -> Mask4 {
+    fn ne(self, rhs: Self) -> Mask4 {
         self.compare(rhs, |a, b| a != b)
+    }
+
+    #[inline(always)]
+    fn gather(bodies: &[SoftBody], index: &[u32; 4], row: BodyRow) -> [Self; 4] {
+        let rows = [0, 1, 2, 3].map(|k| bodies[index[k] as usize].row(row));
+        std::array::from_fn(|c| Self::from_fn(|k| rows[k][c]))
+    }
+
+    #[inline(always)]
+    fn scatter_velocities([x, y, w, _]: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]) {
+        for k in 0..4 {
+            let body = &mut bodies[index[k] as usize];
+            body.v.x = x.0[k];
+            body.v.y = y.0[k];
+            body.w = w.0[k];
+        }
     }
 }
 
-impl Mask4 {
+impl LaneMask<F64x4> for Mask4 {
     #[inline(always)]
-    pub fn any(self) -> bool {
+    fn any(self) -> bool {
         self.0.iter().fold(0, |any, &m| any | m) != 0
     }
 
-    /// `if_true` where the condition holds, `if_false` elsewhere (bit for bit).
     #[inline(always)]
-    pub fn select(self, if_true: F64x4, if_false: F64x4) -> F64x4 {
+    fn select(self, if_true: F64x4, if_false: F64x4) -> F64x4 {
         F64x4::from_fn(|k| {
             let m = self.0[k];
             f64::from_bits((if_true.0[k].to_bits() & m) | (if_false.0[k].to_bits() & !m))
