@@ -59,6 +59,10 @@ pub(super) struct PassPlan {
     colours_of: Vec<u32>,
     /// `(colour, first point, point count)` of the coloured manifolds.
     coloured: Vec<(u32, u32, u32)>,
+    /// The counting sort of `coloured` by colour: its output, and where each colour
+    /// starts in it.
+    by_colour: Vec<(u32, u32, u32)>,
+    colour_starts: Vec<u32>,
 }
 
 impl PassPlan {
@@ -97,8 +101,24 @@ impl PassPlan {
                 first += count as usize;
             }
         }
-        // A stable sort: each colour keeps the points' order.
-        self.coloured.sort_by_key(|c| c.0);
+        // Grouped by colour, each colour in the points' order (a counting sort: the
+        // colours are few, a big pile's manifolds many).
+        self.colour_starts.clear();
+        self.colour_starts.resize(COLOURS as usize + 2, 0);
+        for &(c, _, _) in &self.coloured {
+            self.colour_starts[c as usize + 1] += 1;
+        }
+        for c in 1..self.colour_starts.len() {
+            self.colour_starts[c] += self.colour_starts[c - 1];
+        }
+        self.by_colour.clear();
+        self.by_colour.resize(self.coloured.len(), (0, 0, 0));
+        for &m in &self.coloured {
+            let at = &mut self.colour_starts[m.0 as usize];
+            self.by_colour[*at as usize] = m;
+            *at += 1;
+        }
+        std::mem::swap(&mut self.coloured, &mut self.by_colour);
         // Two-point and one-point manifolds fill their own batches, colour by colour.
         let mut i = 0;
         while i < self.coloured.len() {
