@@ -121,7 +121,14 @@ mod tests {
                 })
                 .collect();
             let fixed = |s: u32| s % 7 == 3;
-            group_by_island(items.len(), bodies, |i| items[i], |s| !fixed(s), &mut uf, &mut out);
+            group_by_island(
+                items.len(),
+                bodies,
+                |i| items[i],
+                |s| !fixed(s),
+                &mut uf,
+                &mut out,
+            );
             let mut expected = out.clone();
             expected.sort_unstable();
             assert_eq!(out, expected, "round {round}");
@@ -131,6 +138,9 @@ mod tests {
             // Whether the counting sort had work to do here.
             interleaved += usize::from(by_item.windows(2).any(|w| w[1].1 < w[0].1));
         }
-        assert!(interleaved > 20, "only {interleaved} of 50 rounds were out of order");
+        assert!(
+            interleaved > 20,
+            "only {interleaved} of 50 rounds were out of order"
+        );
     }
 }

@@ -801,7 +801,10 @@ fn apply_normal(pair: &mut BodyPair, p: &mut PointConstraint, total: f64) {
     let total = total.max(0.0);
     let delta = total - p.normal_impulse;
     p.normal_impulse = total;
-    p.max_normal_impulse = p.max_normal_impulse.max(delta);
+    // Only read where the point may bounce (`approach`, `restitution`).
+    if p.restitution != 0.0 {
+        p.max_normal_impulse = p.max_normal_impulse.max(delta);
+    }
     pair.apply_along(p.normal, p.levers.normal, delta);
 }
 
