@@ -117,6 +117,7 @@ const _: () = {
     assert!(offset_of!(SoftBody, inv_mass) == 24);
     assert!(offset_of!(SoftBody, dp) == 32 && offset_of!(SoftBody, dq) == 48);
     assert!(offset_of!(Rot, cos) == 0 && offset_of!(Rot, sin) == 8);
+    assert!(std::mem::align_of::<SoftBody>() == 32 && size_of::<SoftBody>() == 96);
 };
 
 impl SoftBody {

@@ -34,8 +34,9 @@ const _: () = {
 };
 
 // SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions this
-// type is used in are compiled for and only called with; the loads and stores touch only
-// the 32-byte rows `row` names, inside their bodies.
+// type is used in are compiled for and only called with (`ManifoldBatch::as_avx2`); the
+// aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
+// inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`.
 
 /// Row `k` of the four becomes lane `k` of each column (and back: it is its own inverse).
 #[inline(always)]
@@ -58,6 +59,13 @@ fn transpose([r0, r1, r2, r3]: [__m256d; 4]) -> [__m256d; 4] {
 #[inline(always)]
 fn row(bodies: &[SoftBody], index: u32, row: BodyRow) -> *const f64 {
     let body: *const SoftBody = &bodies[index as usize];
+    body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
+}
+
+/// `row`, to write through: made from the mutable borrow, not a shared one.
+#[inline(always)]
+fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
+    let body: *mut SoftBody = &mut bodies[index as usize];
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
@@ -127,7 +135,7 @@ impl Lanes for F64x4Avx2 {
         let [c0, c1, c2, c3] = columns;
         let rows = transpose([c0.0, c1.0, c2.0, c3.0]);
         for k in 0..4 {
-            let at = row(bodies, index[k], BodyRow::Velocity).cast_mut();
+            let at = row_mut(bodies, index[k], BodyRow::Velocity);
             unsafe { _mm256_store_pd(at, rows[k]) };
         }
     }

@@ -302,8 +302,8 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x4> {
     first_point: [u32; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
-    /// Whether a lane's points may bounce: only then are `bounce`'s lanes read or written
-    /// during the passes (they change nothing where restitution is 0).
+    /// Whether any lane's points may bounce: only then are `bounce`'s lanes read or
+    /// written during the passes (they change nothing where restitution is 0).
     may_bounce: bool,
     inv_inertia_a: L,
     inv_inertia_b: L,
@@ -325,6 +325,7 @@ const _: () = {
     assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x4Avx2>>());
     assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x4Avx2>>());
     assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x4Avx2>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, F64x4Avx2>>());
 };
 
 impl<const N: usize> Default for ManifoldBatch<N> {
@@ -451,16 +452,21 @@ impl<const N: usize> ManifoldBatch<N> {
 
     /// The batch as AVX2 registers: the same bytes (`repr(C)`, lanes of one size and
     /// alignment, asserted above; any bits are valid in either).
+    ///
+    /// # Safety
+    /// The processor must have AVX2: every operation on the result is an AVX2 instruction.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn as_avx2(&self) -> &ManifoldBatch<N, F64x4Avx2> {
+    unsafe fn as_avx2(&self) -> &ManifoldBatch<N, F64x4Avx2> {
         // SAFETY: see above; the borrow is `self`'s.
         unsafe { &*(self as *const Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
     }
 
+    /// # Safety
+    /// As `as_avx2`.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    fn as_avx2_mut(&mut self) -> &mut ManifoldBatch<N, F64x4Avx2> {
+    unsafe fn as_avx2_mut(&mut self) -> &mut ManifoldBatch<N, F64x4Avx2> {
         // SAFETY: as `as_avx2`.
         unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
     }
@@ -469,13 +475,15 @@ impl<const N: usize> ManifoldBatch<N> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        self.as_avx2().warm_start_lanes(bodies)
+        // SAFETY: this function runs only where the processor has AVX2 (`warm_start`).
+        unsafe { self.as_avx2() }.warm_start_lanes(bodies)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        self.as_avx2_mut().solve_lanes(bodies, pass)
+        // SAFETY: this function runs only where the processor has AVX2 (`solve`).
+        unsafe { self.as_avx2_mut() }.solve_lanes(bodies, pass)
     }
 
     /// Fills the batch with the manifolds whose first points are `first_point`.
@@ -667,7 +675,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
         let soft_differs =
             pass.use_bias && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
-        let one_by_one = (soft_differs && mixed.any()).then_some((*pair, self.points, self.bounce));
+        // Copied only when needed (a batch's points are 1,000 bytes).
+        let one_by_one = if soft_differs && mixed.any() {
+            Some((*pair, self.points, self.bounce))
+        } else {
+            None
+        };
         let points = &self.points[..];
         let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
         let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
@@ -963,25 +976,23 @@ mod tests {
         }
     }
 
-    /// Every point made unable to bounce (a pile's): the batch then leaves its bounce
-    /// lanes alone, as the scalar code leaves such points' approach and largest push.
-    fn without_bounce(points: &[PointConstraint]) -> Vec<PointConstraint> {
-        let still = |p: &PointConstraint| PointConstraint {
-            restitution: 0.0,
-            ..*p
-        };
-        points.iter().map(still).collect()
+    /// `four_manifolds(k)` for `seed` 2k − 1 and 2k, the odd one with every point made
+    /// unable to bounce (a pile's): the batch then leaves its bounce lanes alone, as the
+    /// scalar code leaves such points' approach and largest push.
+    fn four_manifolds_both_ways(seed: u64) -> (Vec<SoftBody>, Vec<PointConstraint>) {
+        let (bodies, mut points) = four_manifolds(seed.div_ceil(2));
+        if seed % 2 == 1 {
+            for p in &mut points {
+                p.restitution = 0.0;
+            }
+        }
+        (bodies, points)
     }
 
     #[test]
     fn a_batch_solves_as_its_manifolds_one_after_another() {
         for seed in 1..=398u64 {
-            let (bodies, points) = four_manifolds(seed.div_ceil(2));
-            let points = if seed % 2 == 1 {
-                without_bounce(&points)
-            } else {
-                points
-            };
+            let (bodies, points) = four_manifolds_both_ways(seed);
             for use_bias in [true, false] {
                 let pass = pass(use_bias);
                 let (mut one_by_one, mut their_points) = (bodies.clone(), points.clone());
@@ -1004,12 +1015,7 @@ mod tests {
     fn a_batch_of_one_point_manifolds_solves_as_they_do_one_after_another() {
         for seed in 1..=398u64 {
             // The first point of each of four manifolds, each alone.
-            let (bodies, pairs) = four_manifolds(seed.div_ceil(2));
-            let pairs = if seed % 2 == 1 {
-                without_bounce(&pairs)
-            } else {
-                pairs
-            };
+            let (bodies, pairs) = four_manifolds_both_ways(seed);
             let points: Vec<PointConstraint> = pairs
                 .iter()
                 .step_by(2)

@@ -37,8 +37,9 @@ pub(super) trait Lanes:
     /// numbers as four columns (`SoftBody::row`).
     fn gather(bodies: &[SoftBody], index: &[u32; 4], row: BodyRow) -> [Self; 4];
     /// Writes the velocity row's first three columns back, lane 0 first, so that a fixed
-    /// body in several lanes keeps the last lane's, as when its manifolds are solved one
-    /// after another; the fourth column must be the inverse masses `gather` read.
+    /// body in several lanes of one side keeps the last lane's, as the scalar lane-by-lane
+    /// stores left it (it can differ only in the sign of a zero); the fourth column must
+    /// be the inverse masses `gather` read.
     fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]);
 }
 
