@@ -5,7 +5,7 @@
 #[derive(Debug, Clone, Default)]
 pub struct UnionFind {
     parent: Vec<u32>,
-    /// `group_by_island`'s counting sort: items per root, then where each root's start.
+    /// `group_by_island`'s counting sort by root (`counting_sort`'s scratch).
     starts: Vec<u32>,
     /// `group_by_island`'s items in their first order, before the sort.
     unsorted: Vec<(u32, u32)>,
@@ -76,22 +76,36 @@ pub fn group_by_island(
     if sorted {
         return; // one island, or islands one after another (the items are in order)
     }
-    // A counting sort by root, stable, so each island's items keep their order: the
-    // result of sorting the (root, item) pairs, in O(items + bodies) instead of a
-    // comparison sort's O(items log items) (many piles: 30,000 contact points a step).
+    // Stable, so each island's items keep their order: the result of sorting the
+    // (root, item) pairs, in O(items + bodies) instead of a comparison sort's
+    // O(items log items) (many piles: 30,000 contact points a step).
     std::mem::swap(out, &mut uf.unsorted);
-    uf.starts.clear();
-    uf.starts.resize(bodies + 1, 0);
-    for &(root, _) in &uf.unsorted {
-        uf.starts[root as usize + 1] += 1;
+    let by_root = |&(root, _): &(u32, u32)| root as usize;
+    counting_sort(&uf.unsorted, bodies, by_root, &mut uf.starts, out);
+}
+
+/// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
+/// is scratch, kept by the caller so that a step allocates nothing.
+pub fn counting_sort<T: Copy>(
+    items: &[T],
+    keys: usize,
+    key: impl Fn(&T) -> usize,
+    starts: &mut Vec<u32>,
+    out: &mut Vec<T>,
+) {
+    starts.clear();
+    starts.resize(keys + 1, 0);
+    for item in items {
+        starts[key(item) + 1] += 1;
     }
-    for r in 1..uf.starts.len() {
-        uf.starts[r] += uf.starts[r - 1];
+    for k in 1..starts.len() {
+        starts[k] += starts[k - 1];
     }
-    out.resize(uf.unsorted.len(), (0, 0));
-    for &(root, item) in &uf.unsorted {
-        let at = &mut uf.starts[root as usize];
-        out[*at as usize] = (root, item);
+    out.clear();
+    out.extend_from_slice(items); // every slot is overwritten below
+    for &item in items {
+        let at = &mut starts[key(&item)];
+        out[*at as usize] = item;
         *at += 1;
     }
 }

@@ -15,7 +15,6 @@ use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use batch::{PassItem, PassPlan, PassSettings};
-use f64x4::BodyRow;
 use nalgebra::{DMatrix, DVector};
 
 #[cfg(target_arch = "x86_64")]
@@ -107,6 +106,15 @@ struct SoftBody {
     dq: Rot,
     inv_inertia: f64,
     dangle: f64,
+}
+
+/// Which four numbers of a body a batch reads together (`SoftBody::row`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum BodyRow {
+    /// `v.x, v.y, w, inv_mass`.
+    Velocity,
+    /// `dp.x, dp.y, dq.cos, dq.sin`.
+    Motion,
 }
 
 // The rows `SoftBody::row_offset` names.

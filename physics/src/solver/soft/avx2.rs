@@ -12,8 +12,8 @@
 //! known to have AVX2: its operations are `#[inline(always)]` wrappers of intrinsics that
 //! become single instructions when inlined there.
 
-use super::SoftBody;
-use super::f64x4::{BodyRow, F64x4, LaneMask, Lanes};
+use super::f64x4::{F64x4, LaneMask, Lanes};
+use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 

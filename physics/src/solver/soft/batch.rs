@@ -20,8 +20,9 @@
 
 #[cfg(target_arch = "x86_64")]
 use super::avx2::F64x4Avx2;
-use super::f64x4::{BodyRow, F64x4, LaneMask, Lanes};
-use super::{PointConstraint, SoftBody, Softness};
+use super::f64x4::{F64x4, LaneMask, Lanes};
+use super::{BodyRow, PointConstraint, SoftBody, Softness};
+use crate::solver::island::counting_sort;
 
 const LANES: usize = 4;
 
@@ -103,21 +104,15 @@ impl PassPlan {
         }
         // Grouped by colour, each colour in the points' order (a counting sort: the
         // colours are few, a big pile's manifolds many).
-        self.colour_starts.clear();
-        self.colour_starts.resize(COLOURS as usize + 2, 0);
-        for &(c, _, _) in &self.coloured {
-            self.colour_starts[c as usize + 1] += 1;
-        }
-        for c in 1..self.colour_starts.len() {
-            self.colour_starts[c] += self.colour_starts[c - 1];
-        }
-        self.by_colour.clear();
-        self.by_colour.resize(self.coloured.len(), (0, 0, 0));
-        for &m in &self.coloured {
-            let at = &mut self.colour_starts[m.0 as usize];
-            self.by_colour[*at as usize] = m;
-            *at += 1;
-        }
+        let colour = |&(c, _, _): &(u32, u32, u32)| c as usize;
+        let keys = COLOURS as usize; // colours 0..COLOURS (`colour_of`)
+        counting_sort(
+            &self.coloured,
+            keys,
+            colour,
+            &mut self.colour_starts,
+            &mut self.by_colour,
+        );
         std::mem::swap(&mut self.coloured, &mut self.by_colour);
         // Two-point and one-point manifolds fill their own batches, colour by colour.
         let mut i = 0;

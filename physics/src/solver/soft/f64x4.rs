@@ -4,7 +4,7 @@
 //! `ManifoldBatch::solve`). Every lane rounds as the scalar code does, so both give the
 //! same bits.
 
-use super::SoftBody;
+use super::{BodyRow, SoftBody};
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 
 /// Four lanes of f64 and what the batches do with them. A batch is stored with
@@ -48,15 +48,6 @@ pub(super) trait LaneMask<L>: Copy + BitAnd<Output = Self> + BitXor<Output = Sel
     fn any(self) -> bool;
     /// `if_true` where the condition holds, `if_false` elsewhere (bit for bit).
     fn select(self, if_true: L, if_false: L) -> L;
-}
-
-/// Which four numbers of a body a batch reads together (`SoftBody::row`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum BodyRow {
-    /// `v.x, v.y, w, inv_mass`.
-    Velocity,
-    /// `dp.x, dp.y, dq.cos, dq.sin`.
-    Motion,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
