@@ -105,6 +105,8 @@ pub struct Manifold {
     pub normal: Vec2,
     points: [ContactPoint; 2],
     len: u8,
+    /// Whether the reference edge (the one the points were clipped against) is B's.
+    pub(crate) reference_is_b: bool,
 }
 
 impl Manifold {
@@ -115,6 +117,7 @@ impl Manifold {
             normal,
             points: [ContactPoint::default(); 2],
             len: 0,
+            reference_is_b: false,
         }
     }
 

@@ -122,6 +122,7 @@ impl ManifoldCache {
         };
         let u = reference.rotation.apply(cached.normal);
         let mut manifold = Manifold::new(a, b, if cached.reference_is_b { u } else { -u });
+        manifold.reference_is_b = cached.reference_is_b;
         for p in &cached.points[..cached.len as usize] {
             let point = incident.to_world(p.incident);
             let separation = u.dot(&(point - reference.to_world(p.reference)));
@@ -142,13 +143,11 @@ impl ManifoldCache {
 
     /// Keeps a freshly found manifold for the next steps.
     pub fn store(&mut self, manifold: &Manifold, (pose_a, pose_b): (&Pose, &Pose), margin: f64) {
-        let Some(first) = manifold.points().first() else {
+        if manifold.points().is_empty() {
             return;
-        };
-        // collide_polygons marks a manifold whose reference edge is B's in bit 31 of every
-        // point's feature id; the normal is the reference normal, or its opposite when the
-        // reference is A's.
-        let reference_is_b = first.id.0 & (1 << 31) != 0;
+        }
+        // The normal is the reference normal, or its opposite when the reference is A's.
+        let reference_is_b = manifold.reference_is_b;
         let (reference, incident, u) = if reference_is_b {
             (pose_b, pose_a, manifold.normal)
         } else {
@@ -237,7 +236,7 @@ mod tests {
                 let (poly_b, pose_b) = placed(&b.0, b.1, b.2);
                 let first = collide_polygons((handle_a, &poly_a), (handle_b, &poly_b), margin, tie)
                     .expect("in contact");
-                references_seen[(first.points()[0].id.0 >> 31) as usize] = true;
+                references_seen[first.reference_is_b as usize] = true;
                 let mut cache = ManifoldCache::default();
                 cache.store(&first, (&pose_a, &pose_b), margin);
                 for k in 0..16 {
