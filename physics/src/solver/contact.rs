@@ -28,7 +28,15 @@ impl ContactMemory {
         out.clear();
         let mut cursor = 0;
         let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
-        for c in contacts {
+        for (k, c) in contacts.iter().enumerate() {
+            // A pile at rest keeps its contacts from step to step, in the same order: the
+            // k-th entry is then this contact's (keys are unique, so the search below
+            // would find the same one).
+            let key = (c.body_a, c.body_b, c.id.0);
+            if let Some(m) = self.entries.get(k).filter(|m| m.0 == key) {
+                out.push((m.1, m.2));
+                continue;
+            }
             let pair = (c.body_a, c.body_b);
             while self.entries.get(cursor).is_some_and(|m| pair_of(m) < pair) {
                 cursor += 1;
