@@ -1364,7 +1364,7 @@ impl World {
             s.poses.push(pose);
             s.boxes.push(body.as_ref().map(|b| {
                 // The outline from the pose (one rotation per body, shared with reuse).
-                polygon.set_vertices(b.local_vertices().iter().map(|&v| pose.to_world(v)));
+                polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
                 polygon.aabb().grown(0.5 * margin + reach)
             }));
         }
@@ -1442,6 +1442,8 @@ impl World {
                 None
             };
             let found = reused.or_else(|| {
+                s.polygons[i as usize].ensure_normals();
+                s.polygons[j as usize].ensure_normals();
                 let found = collide_polygons(
                     (a, &s.polygons[i as usize]),
                     (b, &s.polygons[j as usize]),

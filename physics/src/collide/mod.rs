@@ -59,9 +59,23 @@ impl WorldPolygon {
 
     /// Refills `self` from world vertices in the positive order.
     pub fn set_vertices(&mut self, vertices: impl Iterator<Item = Vec2>) {
+        self.set_outline(vertices);
+        self.ensure_normals();
+    }
+
+    /// Refills the vertices only; `ensure_normals` adds the normals when a test needs
+    /// them (a pile at rest reuses its manifolds and needs only the bounds).
+    pub fn set_outline(&mut self, vertices: impl Iterator<Item = Vec2>) {
         self.vertices.clear();
         self.vertices.extend(vertices);
         self.normals.clear();
+    }
+
+    /// Computes the edge normals if `set_outline` left them out.
+    pub fn ensure_normals(&mut self) {
+        if !self.normals.is_empty() {
+            return;
+        }
         let n = self.vertices.len();
         for i in 0..n {
             let e = self.vertices[(i + 1) % n] - self.vertices[i];

@@ -364,9 +364,18 @@ mod tests {
     fn swapping_the_reference_face_keeps_each_points_id() {
         let tilt = 2e-4;
         for (a, b) in [
-            (square(1.0, (0.0, 0.0), 0.0), square(1.0, (0.3, 0.999), tilt)),
-            (square(1.0, (0.2, 0.999), -tilt), square(1.0, (0.0, 0.0), tilt)),
-            (square(2.0, (0.0, 0.0), 0.0), square(1.0, (0.0, -1.499), tilt)),
+            (
+                square(1.0, (0.0, 0.0), 0.0),
+                square(1.0, (0.3, 0.999), tilt),
+            ),
+            (
+                square(1.0, (0.2, 0.999), -tilt),
+                square(1.0, (0.0, 0.0), tilt),
+            ),
+            (
+                square(2.0, (0.0, 0.0), 0.0),
+                square(1.0, (0.0, -1.499), tilt),
+            ),
         ] {
             let on_a = collide_polygons((A, &a), (B, &b), 0.02, 1.0).unwrap();
             let on_b = collide_polygons((A, &a), (B, &b), 0.02, -1.0).unwrap();
