@@ -84,6 +84,52 @@ pub fn group_by_island(
     counting_sort(&uf.unsorted, bodies, by_root, &mut uf.starts, out);
 }
 
+/// `group_by_island` with its last result kept: a pile at rest has the same contacts,
+/// between the same bodies, step after step, and then the islands are those it found.
+#[derive(Debug, Clone, Default)]
+pub struct IslandGrouping {
+    uf: UnionFind,
+    /// The last call's item ends and which bodies connected.
+    ends: Vec<(u32, u32)>,
+    dynamic: Vec<bool>,
+    grouped: Vec<(u32, u32)>,
+}
+
+impl IslandGrouping {
+    /// `group_by_island`'s result for these items, found again only if an item's ends or
+    /// a body's `dynamic` differ from the last call's.
+    pub fn group(
+        &mut self,
+        count: usize,
+        bodies: usize,
+        ends: impl Fn(usize) -> (u32, u32),
+        dynamic: impl Fn(u32) -> bool,
+    ) -> &[(u32, u32)] {
+        let same_bodies = self.dynamic.len() == bodies
+            && self
+                .dynamic
+                .iter()
+                .enumerate()
+                .all(|(i, &d)| d == dynamic(i as u32));
+        let same_items = self.ends.len() == count && (0..count).all(|i| self.ends[i] == ends(i));
+        if !(same_bodies && same_items) {
+            self.dynamic.clear();
+            self.dynamic.extend((0..bodies as u32).map(&dynamic));
+            self.ends.clear();
+            self.ends.extend((0..count).map(&ends));
+            group_by_island(
+                count,
+                bodies,
+                ends,
+                dynamic,
+                &mut self.uf,
+                &mut self.grouped,
+            );
+        }
+        &self.grouped
+    }
+}
+
 /// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
 /// is scratch, kept by the caller so that a step allocates nothing.
 pub fn counting_sort<T: Copy>(
@@ -122,6 +168,35 @@ mod tests {
         let mut out = vec![];
         group_by_island(items.len(), 5, |i| items[i], |s| s != 4, &mut uf, &mut out);
         assert_eq!(out, vec![(0, 0), (0, 1), (2, 2), (2, 3)]);
+    }
+
+    /// The kept grouping is found again whenever an item's ends or a body's flag change,
+    /// and equals a fresh `group_by_island` every time.
+    #[test]
+    fn a_kept_grouping_follows_every_change() {
+        let mut kept = IslandGrouping::default();
+        let cases: [(&[(u32, u32)], u32); 6] = [
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 1), // body 1 now fixed: 0 and 4 part
+            (&[(0, 1), (1, 4), (2, 4), (3, 2)], 1),
+            (&[(0, 1), (1, 4), (2, 4)], 1),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3), (3, 0)], 4),
+        ];
+        for (items, fixed) in cases {
+            let mut uf = UnionFind::default();
+            let mut fresh = vec![];
+            group_by_island(
+                items.len(),
+                5,
+                |i| items[i],
+                |s| s != fixed,
+                &mut uf,
+                &mut fresh,
+            );
+            let got = kept.group(items.len(), 5, |i| items[i], |s| s != fixed);
+            assert_eq!(got, &fresh[..], "{items:?}, body {fixed} fixed");
+        }
     }
 
     /// Items whose islands interleave come out as a sort of the (island, item) pairs

@@ -9,7 +9,7 @@
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
-use super::island::{UnionFind, group_by_island};
+use super::island::{IslandGrouping, UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
@@ -262,6 +262,9 @@ pub struct SoftStepSolver {
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
     joint_islands: Vec<(usize, usize)>,
+    /// The contacts' islands, kept while the contacts stay between the same bodies.
+    contact_grouping: IslandGrouping,
+    /// The pins' islands.
     island_uf: UnionFind,
     grouped: Vec<(u32, u32)>,
     block: JointBlock,
@@ -354,16 +357,14 @@ impl SoftStepSolver {
         self.memory.recall(contacts, &mut self.recalled);
         // The points are built island by island (each island's in the contacts' order):
         // grouping the contacts is cheaper than reordering the larger points afterwards.
-        group_by_island(
+        let grouped = self.contact_grouping.group(
             contacts.len(),
             bodies.len(),
             |i| (contacts[i].body_a, contacts[i].body_b),
             |i| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0,
-            &mut self.island_uf,
-            &mut self.grouped,
         );
-        island_ranges(&self.grouped, &mut self.contact_islands);
-        for &(_, i) in &self.grouped {
+        island_ranges(grouped, &mut self.contact_islands);
+        for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
             let r_a = c.point - a.position;
