@@ -57,13 +57,6 @@ pub fn collide_polygons(
             });
         }
     }
-    if let [first, second] = manifold.points_mut()
-        && second.id < first.id
-    {
-        // Swapping the reference face reverses the points' order: put it back, so that
-        // the solver sees the same manifold either way.
-        std::mem::swap(first, second);
-    }
     if manifold.points().is_empty() {
         // Clipping can lose both points in a deep, skewed overlap: fall back to the
         // incident vertex that reaches deepest past the reference edge.
@@ -358,8 +351,9 @@ mod tests {
     }
 
     /// Near-parallel faces can take either body's edge as the reference from one step to
-    /// the next. A negative tie tolerance forces B's; the points must keep their ids and
-    /// order (their warm start), and move by no more than the tilt can explain.
+    /// the next. A negative tie tolerance forces B's; the points must keep their ids
+    /// (their warm start) and move by no more than the tilt can explain. (The swap
+    /// reverses their order, which the solvers do not match by.)
     #[test]
     fn swapping_the_reference_face_keeps_each_points_id() {
         let tilt = 2e-4;
@@ -381,11 +375,12 @@ mod tests {
             let on_b = collide_polygons((A, &a), (B, &b), 0.02, -1.0).unwrap();
             assert!(!on_a.reference_is_b && on_b.reference_is_b);
             assert_eq!(on_a.points().len(), 2);
-            let ids = |m: &Manifold| m.points().iter().map(|p| p.id).collect::<Vec<_>>();
-            assert_eq!(ids(&on_a), ids(&on_b));
+            assert_eq!(on_b.points().len(), 2);
             assert_ne!(on_a.points()[0].id, on_a.points()[1].id);
             assert!((on_a.normal - on_b.normal).norm() < 2.0 * tilt);
-            for (p, q) in on_a.points().iter().zip(on_b.points()) {
+            for p in on_a.points() {
+                let q = on_b.points().iter().find(|q| q.id == p.id);
+                let q = q.unwrap_or_else(|| panic!("{:?} lost its id: {on_b:?}", p.id));
                 // Each end is the same corner seen from either face: positions and depths
                 // differ by the tilt times a box's size.
                 assert!((p.position - q.position).norm() < 2.0 * tilt, "{p:?} {q:?}");
