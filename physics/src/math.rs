@@ -74,6 +74,24 @@ mod tests {
         assert_eq!(cross_scalar(2.0, a), perp(a) * 2.0);
     }
 
+    /// The soft step uses a contact's reach r · n as its tangent lever r × perp(n): the
+    /// same products, one negated twice, so the same number (a zero's sign aside).
+    #[test]
+    fn the_tangent_lever_is_the_reach() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        for _ in 0..10_000 {
+            let r = Vec2::new(next(), next());
+            let n = Rot::new(3.2 * next()).apply(Vec2::new(1.0, 0.0));
+            assert_eq!(cross(r, perp(n)), r.dot(&n), "r {r:?}, n {n:?}");
+        }
+    }
+
     #[test]
     fn rotation_round_trips() {
         let r = Rot::new(0.7);

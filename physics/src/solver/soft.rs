@@ -217,9 +217,16 @@ impl NormalBlock {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct PointLevers {
     normal: (f64, f64),
-    tangent: (f64, f64),
-    /// `r · n` on A and on B: how far each anchor reaches along the normal.
+    /// `r · n` on A and on B: how far each anchor reaches along the normal. Also the
+    /// tangent row's levers: r × perp(n) = r · n.
     reach: (f64, f64),
+}
+
+impl PointLevers {
+    /// The tangent row's lever arms, r × t with t = perp(n): the reach, r · n.
+    fn tangent(&self) -> (f64, f64) {
+        self.reach
+    }
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
@@ -369,10 +376,8 @@ impl SoftStepSolver {
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
             let r_a = c.point - a.position;
             let r_b = c.point - b.position;
-            let t = perp(c.normal);
             let levers = PointLevers {
                 normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-                tangent: (cross(r_a, t), cross(r_b, t)),
                 reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
             };
             // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
@@ -389,7 +394,7 @@ impl SoftStepSolver {
                 levers,
                 base_separation: -c.depth,
                 normal_mass: mass(levers.normal),
-                tangent_mass: mass(levers.tangent),
+                tangent_mass: mass(levers.tangent()),
                 friction: c.friction,
                 restitution: c.restitution,
                 relative_velocity: c.approach_velocity,
@@ -711,7 +716,7 @@ impl SoftStepSolver {
 fn warm_start_point(bodies: &mut [SoftBody], p: &PointConstraint) {
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     pair.apply_along(p.normal, p.levers.normal, p.normal_impulse);
-    pair.apply_along(perp(p.normal), p.levers.tangent, p.tangent_impulse);
+    pair.apply_along(perp(p.normal), p.levers.tangent(), p.tangent_impulse);
     pair.store(bodies);
 }
 
@@ -886,12 +891,12 @@ fn solve_normal(
 #[inline(always)]
 fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
     let t = perp(p.normal);
-    let vt = pair.velocity_along(t, p.levers.tangent);
+    let vt = pair.velocity_along(t, p.levers.tangent());
     let limit = p.friction * p.normal_impulse;
     let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
-    pair.apply_along(t, p.levers.tangent, delta);
+    pair.apply_along(t, p.levers.tangent(), delta);
 }
 
 /// Two points of one manifold: normals together (when both rows have the same softness),
@@ -1212,7 +1217,7 @@ struct ContactLcp {
 
 /// A point's two rows: direction, and lever arms on A and B.
 fn rows(p: &PointConstraint) -> [(Vec2, f64, f64); 2] {
-    let (n, t) = (p.levers.normal, p.levers.tangent);
+    let (n, t) = (p.levers.normal, p.levers.tangent());
     [(p.normal, n.0, n.1), (perp(p.normal), t.0, t.1)]
 }
 
@@ -1297,7 +1302,7 @@ impl ContactLcp {
                 let (target, _, separation) = point_target(bodies, p, pass);
                 let pair = BodyPair::load(bodies, p.a, p.b);
                 let vn = approach(&pair, p, separation);
-                let vt = pair.velocity_along(perp(p.normal), p.levers.tangent);
+                let vt = pair.velocity_along(perp(p.normal), p.levers.tangent());
                 self.b.extend([vn - target, vt]);
                 self.x.extend([p.normal_impulse, p.tangent_impulse]);
                 self.lo.extend([0.0, 0.0]);
@@ -1330,7 +1335,7 @@ impl ContactLcp {
                 apply_normal(&mut pair, p, self.x[2 * i]);
                 let delta = self.x[2 * i + 1] - p.tangent_impulse;
                 p.tangent_impulse = self.x[2 * i + 1];
-                pair.apply_along(perp(p.normal), p.levers.tangent, delta);
+                pair.apply_along(perp(p.normal), p.levers.tangent(), delta);
                 pair.store(bodies);
             }
         }

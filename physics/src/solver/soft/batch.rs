@@ -264,8 +264,6 @@ impl<const N: usize> BatchPool<N> {
 struct LanePoints<L = F64x4> {
     normal_lever_a: L,
     normal_lever_b: L,
-    tangent_lever_a: L,
-    tangent_lever_b: L,
     reach_a: L,
     reach_b: L,
     base_separation: L,
@@ -507,8 +505,6 @@ impl<const N: usize> ManifoldBatch<N> {
             for (lane, p) in self.points.iter_mut().zip(&points[first as usize..]) {
                 lane.normal_lever_a.0[k] = p.levers.normal.0;
                 lane.normal_lever_b.0[k] = p.levers.normal.1;
-                lane.tangent_lever_a.0[k] = p.levers.tangent.0;
-                lane.tangent_lever_b.0[k] = p.levers.tangent.1;
                 lane.reach_a.0[k] = p.levers.reach.0;
                 lane.reach_b.0[k] = p.levers.reach.1;
                 lane.base_separation.0[k] = p.base_separation;
@@ -572,12 +568,8 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let tangent = (-self.normal_y, self.normal_x);
         for p in &self.points {
             pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, p.normal_impulse);
-            pair.apply_along(
-                tangent,
-                p.tangent_lever_a,
-                p.tangent_lever_b,
-                p.tangent_impulse,
-            );
+            // The tangent row's levers are the reaches (`PointLevers::tangent`).
+            pair.apply_along(tangent, p.reach_a, p.reach_b, p.tangent_impulse);
         }
         self.store(&pair, bodies);
     }
@@ -644,12 +636,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         }
         let tangent = (-self.normal_y, self.normal_x);
         for p in &mut self.points {
-            let vt = pair.velocity_along(tangent, p.tangent_lever_a, p.tangent_lever_b);
+            let vt = pair.velocity_along(tangent, p.reach_a, p.reach_b);
             let limit = self.friction * p.normal_impulse;
             let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
             let delta = total - p.tangent_impulse;
             p.tangent_impulse = total;
-            pair.apply_along(tangent, p.tangent_lever_a, p.tangent_lever_b, delta);
+            pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
         }
         self.store(&pair, bodies);
     }
@@ -805,7 +797,7 @@ fn approach<L: Lanes>(b: &mut LaneBounce<L>, vn: L, separation: L) {
 mod tests {
     use super::super::{NormalBlock, PointLevers, solve_pair, solve_point, warm_start_point};
     use super::*;
-    use crate::math::{Rot, Vec2, cross, perp};
+    use crate::math::{Rot, Vec2, cross};
 
     /// A small deterministic generator (xorshift), uniform in [lo, hi).
     struct Numbers(u64);
@@ -848,10 +840,8 @@ mod tests {
         let (ba, bb) = (&bodies[a as usize], &bodies[b as usize]);
         let r_a = Vec2::new(n.next(-0.5, 0.5), n.next(-0.5, 0.5));
         let r_b = Vec2::new(n.next(-0.5, 0.5), n.next(-0.5, 0.5));
-        let t = perp(normal);
         let levers = PointLevers {
             normal: (cross(r_a, normal), cross(r_b, normal)),
-            tangent: (cross(r_a, t), cross(r_b, t)),
             reach: (r_a.dot(&normal), r_b.dot(&normal)),
         };
         let mass = |(la, lb): (f64, f64)| {
@@ -866,7 +856,7 @@ mod tests {
             levers,
             base_separation: n.next(-0.02, 0.01),
             normal_mass: mass(levers.normal),
-            tangent_mass: mass(levers.tangent),
+            tangent_mass: mass(levers.tangent()),
             friction: 0.6,
             restitution: if bounces { 0.5 } else { 0.0 },
             relative_velocity: n.next(-2.0, 0.0),
