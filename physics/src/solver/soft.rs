@@ -1084,7 +1084,13 @@ impl JointBlock {
         }
         for p in 0..m {
             for q in p..m {
-                let block = coupling(bodies, &island[p], self.arms[p], &island[q], self.arms[q]);
+                // Pins with no body in common do not couple: their block stays zero (a
+                // chain's K is block-tridiagonal).
+                let (jp, jq) = (&island[p], &island[q]);
+                if jp.a != jq.a && jp.a != jq.b && jp.b != jq.a && jp.b != jq.b {
+                    continue;
+                }
+                let block = coupling(bodies, jp, self.arms[p], jq, self.arms[q]);
                 for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
                     k[(2 * p + r, 2 * q + c)] = block[r][c];
                     k[(2 * q + c, 2 * p + r)] = block[r][c];
