@@ -1,6 +1,7 @@
 //! Constraint solvers: contacts, the boxed LCP, joints and motors.
 
 pub mod contact;
+pub mod envelope;
 pub mod island;
 pub mod joint;
 pub mod lcp;

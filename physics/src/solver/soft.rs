@@ -9,13 +9,13 @@
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
+use super::envelope::EnvelopeCholesky;
 use super::island::{IslandGrouping, UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use batch::{PassItem, PassPlan, PassSettings};
-use nalgebra::{DMatrix, DVector};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -282,14 +282,14 @@ pub struct SoftStepSolver {
     pub reports: Vec<IslandReport>,
 }
 
-/// The dense system of one island of pins, reused between passes.
+/// The system of one island of pins, its buffers reused between passes.
 #[derive(Debug, Clone, Default)]
 struct JointBlock {
     arms: Vec<(Vec2, Vec2)>,
-    k: DMatrix<f64>,
-    /// A copy of K, for the rare refactoring with regularisation (the factor consumes K).
-    unfactored: DMatrix<f64>,
-    rhs: DVector<f64>,
+    /// K, row-major, its lower triangle filled.
+    k: Vec<f64>,
+    factor: EnvelopeCholesky,
+    rhs: Vec<f64>,
 }
 
 /// The most a body may turn in one substep (radians).
@@ -1068,12 +1068,12 @@ impl JointBlock {
         use_bias: bool,
     ) -> bool {
         let m = island.len();
+        let n = 2 * m;
         self.arms.clear();
-        // Buffers keep their allocation from pass to pass.
-        let mut k = std::mem::replace(&mut self.k, DMatrix::zeros(0, 0));
-        k.resize_mut(2 * m, 2 * m, 0.0);
-        k.fill(0.0);
-        self.rhs.resize_vertically_mut(2 * m, 0.0);
+        self.k.clear();
+        self.k.resize(n * n, 0.0);
+        self.rhs.clear();
+        self.rhs.resize(n, 0.0);
         let (mut mass_scale, mut impulse_scale) = (1.0, 0.0);
         for (p, j) in island.iter().enumerate() {
             let (arms, target, ms, is) = pin_target(bodies, j, soft, max_push, use_bias);
@@ -1085,15 +1085,17 @@ impl JointBlock {
         for p in 0..m {
             for q in p..m {
                 // Pins with no body in common do not couple: their block stays zero (a
-                // chain's K is block-tridiagonal).
+                // chain's K is block-tridiagonal, which the factorization exploits).
                 let (jp, jq) = (&island[p], &island[q]);
                 if jp.a != jq.a && jp.a != jq.b && jp.b != jq.a && jp.b != jq.b {
                     continue;
                 }
                 let block = coupling(bodies, jp, self.arms[p], jq, self.arms[q]);
+                // The lower triangle: row 2q + c, column 2p + r (a pin's own block: row r,
+                // column c).
                 for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-                    k[(2 * p + r, 2 * q + c)] = block[r][c];
-                    k[(2 * q + c, 2 * p + r)] = block[r][c];
+                    let (row, column) = if p == q { (r, c) } else { (c, r) };
+                    self.k[(2 * q + row) * n + 2 * p + column] = block[r][c];
                 }
             }
         }
@@ -1102,28 +1104,16 @@ impl JointBlock {
         // then is K regularised (by 1e-9 of its largest diagonal, which keeps the impulses
         // bounded): a heavy chain's K is ill-conditioned but regular, and even that much
         // regularisation doubled its gap.
-        let largest = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
-        self.unfactored.resize_mut(2 * m, 2 * m, 0.0);
-        self.unfactored.copy_from(&k);
-        let factor = k.cholesky().filter(|c| {
-            let l = c.l_dirty();
-            (0..2 * m).all(|i| l[(i, i)] * l[(i, i)] > 1e-12 * largest)
-        });
-        let factor = match factor {
-            Some(f) => Some(f),
-            None => {
-                let mut k = std::mem::replace(&mut self.unfactored, DMatrix::zeros(0, 0));
-                for i in 0..2 * m {
-                    k[(i, i)] += 1e-9 * largest;
-                }
-                k.cholesky()
+        let largest = (0..n).map(|i| self.k[i * n + i]).fold(0.0, f64::max);
+        if !self.factor.factor(&self.k, n, 1e-12 * largest) {
+            for i in 0..n {
+                self.k[i * n + i] += 1e-9 * largest;
             }
-        };
-        let Some(cholesky) = factor else {
-            return false;
-        };
-        cholesky.solve_mut(&mut self.rhs);
-        self.k = cholesky.unpack_dirty();
+            if !self.factor.factor(&self.k, n, 0.0) {
+                return false;
+            }
+        }
+        self.factor.solve(&mut self.rhs);
         let psi = &self.rhs;
         for (p, j) in island.iter_mut().enumerate() {
             let impulse =
