@@ -12,6 +12,8 @@ const RELATIVE_TOLERANCE: f64 = 1e-9;
 pub enum ShapeError {
     #[error("a polygon needs at least 3 vertices, this one has {count}")]
     TooFewVertices { count: usize },
+    #[error("a polygon may have at most {limit} vertices, this one has {count}")]
+    TooManyVertices { count: usize, limit: usize },
     #[error("vertex {index} has a coordinate that is not a finite number")]
     NonFiniteCoordinate { index: usize },
     #[error("vertices {first} and {second} are the same point")]
@@ -41,12 +43,22 @@ pub struct MassProperties {
     pub second_moment: f64,
 }
 
+/// The most vertices a polygon may have: contact points are named by vertex indices in 15
+/// bits (`collide::sat`), far beyond any drawn body.
+pub const MAX_VERTICES: usize = 1 << 15;
+
 impl ConvexPolygon {
     /// Validates `points` (either winding) and returns the polygon in positive order.
     pub fn new(points: &[Vec2]) -> Result<Self, ShapeError> {
         if points.len() < 3 {
             return Err(ShapeError::TooFewVertices {
                 count: points.len(),
+            });
+        }
+        if points.len() > MAX_VERTICES {
+            return Err(ShapeError::TooManyVertices {
+                count: points.len(),
+                limit: MAX_VERTICES,
             });
         }
         if let Some(index) = points
@@ -350,6 +362,19 @@ mod tests {
         assert_eq!(
             ConvexPolygon::new(&[v(0., 0.), v(1., 0.)]),
             Err(TooFewVertices { count: 2 })
+        );
+        let circle: Vec<Vec2> = (0..=MAX_VERTICES)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / (MAX_VERTICES + 1) as f64;
+                v(a.cos(), a.sin())
+            })
+            .collect();
+        assert_eq!(
+            ConvexPolygon::new(&circle),
+            Err(TooManyVertices {
+                count: MAX_VERTICES + 1,
+                limit: MAX_VERTICES
+            })
         );
         assert_eq!(
             ConvexPolygon::new(&[v(0., 0.), v(f64::NAN, 0.), v(0., 1.)]),

@@ -104,6 +104,8 @@ fn deepest_vertex(p: &WorldPolygon, u: Vec2, on_plane: Vec2) -> (usize, f64) {
 /// reference edge's first vertex is the incident edge's second, and the other way round.
 /// Which body holds the reference edge does not enter: when near-parallel faces swap the
 /// reference between steps, each point keeps its id, and so its warm start.
+/// Indices are below `shape::MAX_VERTICES` (2¹⁵), so bit 31 stays free for the fallback's
+/// ids.
 fn end_id(vertex_a: u32, vertex_b: u32) -> FeatureId {
     FeatureId((vertex_a << 16) | vertex_b)
 }
