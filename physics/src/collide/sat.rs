@@ -21,11 +21,11 @@ pub fn collide_polygons(
     margin: f64,
     tie_tolerance: f64,
 ) -> Option<Manifold> {
-    let (edge_a, separation_a) = max_separation(a, b);
+    let (edge_a, separation_a) = separation_beyond(a, b, margin);
     if separation_a > margin {
         return None;
     }
-    let (edge_b, separation_b) = max_separation(b, a);
+    let (edge_b, separation_b) = separation_beyond(b, a, margin);
     if separation_b > margin {
         return None;
     }
@@ -74,15 +74,26 @@ pub fn collide_polygons(
 /// The edge of `p` whose outward normal separates `q` most, and that separation
 /// (negative = overlap). Earlier edges win ties.
 pub(super) fn max_separation(p: &WorldPolygon, q: &WorldPolygon) -> (usize, f64) {
+    separation_beyond(p, q, f64::INFINITY)
+}
+
+/// `max_separation`, except that it may stop at the first edge that separates by more
+/// than `enough` (the pair is then apart, whichever edge separates most).
+fn separation_beyond(p: &WorldPolygon, q: &WorldPolygon, enough: f64) -> (usize, f64) {
     let mut best = (0, f64::NEG_INFINITY);
     for (i, (n, v)) in p.normals.iter().zip(&p.vertices).enumerate() {
-        let separation = q
-            .vertices
-            .iter()
-            .map(|w| n.dot(&(w - v)))
-            .fold(f64::INFINITY, f64::min);
+        let mut separation = f64::INFINITY;
+        for w in &q.vertices {
+            separation = separation.min(n.dot(&(w - v)));
+            if separation <= best.1 {
+                break; // this edge cannot beat the best one
+            }
+        }
         if separation > best.1 {
             best = (i, separation);
+            if separation > enough {
+                break;
+            }
         }
     }
     best
