@@ -105,23 +105,23 @@ impl IslandGrouping {
         ends: impl Fn(usize) -> (u32, u32),
         dynamic: impl Fn(u32) -> bool,
     ) -> &[(u32, u32)] {
-        let same_bodies = self.dynamic.len() == bodies
-            && self
-                .dynamic
-                .iter()
-                .enumerate()
-                .all(|(i, &d)| d == dynamic(i as u32));
-        let same_items = self.ends.len() == count && (0..count).all(|i| self.ends[i] == ends(i));
-        if !(same_bodies && same_items) {
+        // Items first: a step that changes anything usually changes them early.
+        let same = self.ends.len() == count
+            && (0..count).all(|i| self.ends[i] == ends(i))
+            && self.dynamic.len() == bodies
+            && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32));
+        if !same {
             self.dynamic.clear();
             self.dynamic.extend((0..bodies as u32).map(&dynamic));
             self.ends.clear();
             self.ends.extend((0..count).map(&ends));
+            // From the copies just taken, not the callers' (larger) items again.
+            let (kept_ends, kept_dynamic) = (&self.ends, &self.dynamic);
             group_by_island(
                 count,
                 bodies,
-                ends,
-                dynamic,
+                |i| kept_ends[i],
+                |s| kept_dynamic[s as usize],
                 &mut self.uf,
                 &mut self.grouped,
             );
