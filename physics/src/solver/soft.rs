@@ -19,8 +19,10 @@ use batch::{PassItem, PassPlan, PassSettings};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod batch;
-mod f64x4;
+mod lanes;
 
 /// Joint islands up to this many pins are solved as one linear system per pass (a dense
 /// Cholesky of 2m × 2m); larger ones pin by pin. One pass of pin-by-pin Gauss–Seidel
@@ -91,9 +93,9 @@ impl Softness {
 
 /// A body during the soft step: velocity, inverse mass, and how far it moved this step.
 ///
-/// Laid out for the batches' AVX2 path (`avx2::F64x4Avx2::gather`), which reads four
-/// bodies' `v, w, inv_mass` as one 32-byte row each and `dp, dq` as another, and
-/// transposes them into lanes: the two rows start at 0 and 32 bytes, and a body is
+/// Laid out for the batches' SIMD paths (`avx2::F64x8Avx2::gather`, `avx512`), which read
+/// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
+/// transpose them into lanes: the two rows start at 0 and 32 bytes, and a body is
 /// 32-byte aligned.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C, align(32))]

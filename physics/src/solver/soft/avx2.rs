@@ -1,7 +1,8 @@
-//! The batches' lanes as one AVX2 register (`Lanes` for `F64x4Avx2`), for the functions
-//! compiled with `#[target_feature(enable = "avx2")]` and nothing else: the compiler had
-//! vectorised `F64x4`'s arrays there, but not their loads from four bodies, which it
-//! split into scalar moves and spilled (a two-point batch's pass took ~720 instructions).
+//! The batches' eight lanes as two AVX2 registers (`Lanes` for `F64x8Avx2`), lanes 0–3
+//! and 4–7, for the functions compiled with `#[target_feature(enable = "avx2")]` and
+//! nothing else: the compiler had vectorised plain arrays there, but not their loads
+//! from the bodies, which it split into scalar moves and spilled (a two-point batch of
+//! four lanes took ~720 instructions a pass).
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
@@ -12,25 +13,25 @@
 //! known to have AVX2: its operations are `#[inline(always)]` wrappers of intrinsics that
 //! become single instructions when inlined there.
 
-use super::f64x4::{F64x4, LaneMask, Lanes};
+use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 
-/// Four f64 lanes in a 256-bit register; the same size and alignment as `F64x4`.
+/// Eight f64 lanes in two 256-bit registers, lanes 0–3 then 4–7; the same size, layout
+/// and alignment as `F64x8`.
 #[derive(Debug, Clone, Copy)]
-#[repr(transparent)]
-pub(super) struct F64x4Avx2(__m256d);
+#[repr(C, align(64))]
+pub(super) struct F64x8Avx2(__m256d, __m256d);
 
-/// A lane-wise condition: all ones or all zeros per lane.
+/// A lane-wise condition: all ones or all zeros per lane, in the lanes' two halves.
 #[derive(Debug, Clone, Copy)]
-#[repr(transparent)]
-pub(super) struct MaskAvx2(__m256d);
+pub(super) struct MaskAvx2(__m256d, __m256d);
 
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<F64x4Avx2>() == size_of::<F64x4>());
-    assert!(align_of::<F64x4Avx2>() == align_of::<F64x4>());
+    assert!(size_of::<F64x8Avx2>() == size_of::<F64x8>());
+    assert!(align_of::<F64x8Avx2>() == align_of::<F64x8>());
 };
 
 // SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions this
@@ -38,7 +39,7 @@ const _: () = {
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
 // inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`.
 
-/// Row `k` of the four becomes lane `k` of each column (and back: it is its own inverse).
+/// Row `k` of four becomes lane `k` of each column (and back: it is its own inverse).
 #[inline(always)]
 fn transpose([r0, r1, r2, r3]: [__m256d; 4]) -> [__m256d; 4] {
     unsafe {
@@ -69,22 +70,35 @@ fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
-impl Lanes for F64x4Avx2 {
+/// `f` on each half of `a` and `b`'s lanes.
+#[inline(always)]
+fn halves(a: F64x8Avx2, b: F64x8Avx2, f: impl Fn(__m256d, __m256d) -> __m256d) -> F64x8Avx2 {
+    F64x8Avx2(f(a.0, b.0), f(a.1, b.1))
+}
+
+/// The comparison `f` on each half, as a mask.
+#[inline(always)]
+fn compare(a: F64x8Avx2, b: F64x8Avx2, f: impl Fn(__m256d, __m256d) -> __m256d) -> MaskAvx2 {
+    MaskAvx2(f(a.0, b.0), f(a.1, b.1))
+}
+
+impl Lanes for F64x8Avx2 {
     type Mask = MaskAvx2;
 
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Self(unsafe { _mm256_set1_pd(x) })
+        let x = unsafe { _mm256_set1_pd(x) };
+        Self(x, x)
     }
 
     #[inline(always)]
     fn max(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_max_pd(self.0, rhs.0) })
+        halves(self, rhs, |a, b| unsafe { _mm256_max_pd(a, b) })
     }
 
     #[inline(always)]
     fn min(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_min_pd(self.0, rhs.0) })
+        halves(self, rhs, |a, b| unsafe { _mm256_min_pd(a, b) })
     }
 
     #[inline(always)]
@@ -94,70 +108,87 @@ impl Lanes for F64x4Avx2 {
 
     #[inline(always)]
     fn sqrt(self) -> Self {
-        Self(unsafe { _mm256_sqrt_pd(self.0) })
+        Self(unsafe { _mm256_sqrt_pd(self.0) }, unsafe {
+            _mm256_sqrt_pd(self.1)
+        })
     }
 
     #[inline(always)]
     fn gt(self, rhs: Self) -> MaskAvx2 {
-        MaskAvx2(unsafe { _mm256_cmp_pd::<_CMP_GT_OQ>(self.0, rhs.0) })
+        compare(self, rhs, |a, b| unsafe {
+            _mm256_cmp_pd::<_CMP_GT_OQ>(a, b)
+        })
     }
 
     #[inline(always)]
     fn ge(self, rhs: Self) -> MaskAvx2 {
-        MaskAvx2(unsafe { _mm256_cmp_pd::<_CMP_GE_OQ>(self.0, rhs.0) })
+        compare(self, rhs, |a, b| unsafe {
+            _mm256_cmp_pd::<_CMP_GE_OQ>(a, b)
+        })
     }
 
     #[inline(always)]
     fn lt(self, rhs: Self) -> MaskAvx2 {
-        MaskAvx2(unsafe { _mm256_cmp_pd::<_CMP_LT_OQ>(self.0, rhs.0) })
+        compare(self, rhs, |a, b| unsafe {
+            _mm256_cmp_pd::<_CMP_LT_OQ>(a, b)
+        })
     }
 
     #[inline(always)]
     fn eq(self, rhs: Self) -> MaskAvx2 {
-        MaskAvx2(unsafe { _mm256_cmp_pd::<_CMP_EQ_OQ>(self.0, rhs.0) })
+        compare(self, rhs, |a, b| unsafe {
+            _mm256_cmp_pd::<_CMP_EQ_OQ>(a, b)
+        })
     }
 
     #[inline(always)]
     fn ne(self, rhs: Self) -> MaskAvx2 {
-        MaskAvx2(unsafe { _mm256_cmp_pd::<_CMP_NEQ_UQ>(self.0, rhs.0) })
+        compare(self, rhs, |a, b| unsafe {
+            _mm256_cmp_pd::<_CMP_NEQ_UQ>(a, b)
+        })
     }
 
     #[inline(always)]
-    fn gather(bodies: &[SoftBody], index: &[u32; 4], which: BodyRow) -> [Self; 4] {
+    fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
         // Written out: `array::map` was left out of line here.
         let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[k], which)) };
-        let [c0, c1, c2, c3] = transpose([load(0), load(1), load(2), load(3)]);
-        [Self(c0), Self(c1), Self(c2), Self(c3)]
+        let [a0, a1, a2, a3] = transpose([load(0), load(1), load(2), load(3)]);
+        let [b0, b1, b2, b3] = transpose([load(4), load(5), load(6), load(7)]);
+        [Self(a0, b0), Self(a1, b1), Self(a2, b2), Self(a3, b3)]
     }
 
     #[inline(always)]
-    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]) {
+    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]) {
         let [c0, c1, c2, c3] = columns;
-        let rows = transpose([c0.0, c1.0, c2.0, c3.0]);
-        for k in 0..4 {
+        let low = transpose([c0.0, c1.0, c2.0, c3.0]);
+        let high = transpose([c0.1, c1.1, c2.1, c3.1]);
+        for (k, row) in low.into_iter().chain(high).enumerate() {
             let at = row_mut(bodies, index[k], BodyRow::Velocity);
-            unsafe { _mm256_store_pd(at, rows[k]) };
+            unsafe { _mm256_store_pd(at, row) };
         }
     }
 }
 
-impl F64x4Avx2 {
+impl F64x8Avx2 {
     /// `if lo > self { lo } else { self }`, the lower bound of `clamp`.
     #[inline(always)]
     fn max_of(self, lo: Self) -> Self {
-        Self(unsafe { _mm256_max_pd(lo.0, self.0) })
+        halves(lo, self, |a, b| unsafe { _mm256_max_pd(a, b) })
     }
 }
 
-impl LaneMask<F64x4Avx2> for MaskAvx2 {
+impl LaneMask<F64x8Avx2> for MaskAvx2 {
     #[inline(always)]
     fn any(self) -> bool {
-        unsafe { _mm256_movemask_pd(self.0) != 0 }
+        unsafe { _mm256_movemask_pd(_mm256_or_pd(self.0, self.1)) != 0 }
     }
 
     #[inline(always)]
-    fn select(self, if_true: F64x4Avx2, if_false: F64x4Avx2) -> F64x4Avx2 {
-        F64x4Avx2(unsafe { _mm256_blendv_pd(if_false.0, if_true.0, self.0) })
+    fn select(self, if_true: F64x8Avx2, if_false: F64x8Avx2) -> F64x8Avx2 {
+        F64x8Avx2(
+            unsafe { _mm256_blendv_pd(if_false.0, if_true.0, self.0) },
+            unsafe { _mm256_blendv_pd(if_false.1, if_true.1, self.1) },
+        )
     }
 }
 
@@ -165,7 +196,9 @@ impl BitAnd for MaskAvx2 {
     type Output = Self;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_and_pd(self.0, rhs.0) })
+        Self(unsafe { _mm256_and_pd(self.0, rhs.0) }, unsafe {
+            _mm256_and_pd(self.1, rhs.1)
+        })
     }
 }
 
@@ -173,24 +206,26 @@ impl BitXor for MaskAvx2 {
     type Output = Self;
     #[inline(always)]
     fn bitxor(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_xor_pd(self.0, rhs.0) })
+        Self(unsafe { _mm256_xor_pd(self.0, rhs.0) }, unsafe {
+            _mm256_xor_pd(self.1, rhs.1)
+        })
     }
 }
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $intrinsic:ident) => {
-        impl $trait for F64x4Avx2 {
+        impl $trait for F64x8Avx2 {
             type Output = Self;
             #[inline(always)]
             fn $method(self, rhs: Self) -> Self {
-                Self(unsafe { $intrinsic(self.0, rhs.0) })
+                halves(self, rhs, |a, b| unsafe { $intrinsic(a, b) })
             }
         }
 
-        impl $assign_trait for F64x4Avx2 {
+        impl $assign_trait for F64x8Avx2 {
             #[inline(always)]
             fn $assign(&mut self, rhs: Self) {
-                *self = Self(unsafe { $intrinsic(self.0, rhs.0) });
+                *self = halves(*self, rhs, |a, b| unsafe { $intrinsic(a, b) });
             }
         }
     };
@@ -199,19 +234,22 @@ macro_rules! lane_op {
 lane_op!(Add, add, AddAssign, add_assign, _mm256_add_pd);
 lane_op!(Sub, sub, SubAssign, sub_assign, _mm256_sub_pd);
 
-impl Mul for F64x4Avx2 {
+impl Mul for F64x8Avx2 {
     type Output = Self;
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_mul_pd(self.0, rhs.0) })
+        halves(self, rhs, |a, b| unsafe { _mm256_mul_pd(a, b) })
     }
 }
 
-impl Neg for F64x4Avx2 {
+impl Neg for F64x8Avx2 {
     type Output = Self;
     /// The sign bit flipped, as `-x` does.
     #[inline(always)]
     fn neg(self) -> Self {
-        Self(unsafe { _mm256_xor_pd(self.0, _mm256_set1_pd(-0.0)) })
+        let sign = unsafe { _mm256_set1_pd(-0.0) };
+        Self(unsafe { _mm256_xor_pd(self.0, sign) }, unsafe {
+            _mm256_xor_pd(self.1, sign)
+        })
     }
 }

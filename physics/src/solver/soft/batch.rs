@@ -1,15 +1,15 @@
-//! The passes' order over a step's manifolds, and four manifolds solved side by side,
-//! one per SIMD lane, as Box2D v3 does.
+//! The passes' order over a step's manifolds, and eight manifolds solved side by side,
+//! one per SIMD lane, as Box2D v3 does (in f32; here in f64).
 //!
 //! Manifolds of a big island are grouped by colours of the constraint graph (no two in a
 //! colour share a moving body), as Box2D v3 assigns them: manifolds between two moving
 //! bodies from the first colour up, those against a fixed body from the last colour down,
 //! so that contacts with the ground have the last word in every pass. (Against a fixed
-//! body first, the 100-row pyramid fell: 2,068 of 5,050 boxes.) Within a colour, four
-//! coupled two-point manifolds at a time are one `ManifoldBatch<2>`, and four one-point
+//! body first, the 100-row pyramid fell: 2,068 of 5,050 boxes.) Within a colour, eight
+//! coupled two-point manifolds at a time are one `ManifoldBatch<2>`, and eight one-point
 //! ones a `ManifoldBatch<1>`, solved with the same arithmetic as `solve_pair` and
-//! `solve_point`, lane by lane, so a batch gives the same bits as its four manifolds
-//! solved one after another. Small islands keep the points' order, one
+//! `solve_point`, lane by lane, so a batch gives the same bits as its eight manifolds
+//! solved one after another, whichever lanes the processor has. Small islands keep the points' order, one
 //! manifold at a time.
 //!
 //! Against the points' order (by body pair: a pile's bottom row first), colours stand the
@@ -19,12 +19,12 @@
 //! in the points' order): see docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
-use super::avx2::F64x4Avx2;
-use super::f64x4::{F64x4, LaneMask, Lanes};
+use super::avx2::F64x8Avx2;
+#[cfg(target_arch = "x86_64")]
+use super::avx512::F64x8Avx512;
+use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, PointConstraint, SoftBody, Softness};
 use crate::solver::island::counting_sort;
-
-const LANES: usize = 4;
 
 /// Colours of the constraint graph (Box2D v3's count, whose last is its overflow; here a
 /// manifold that finds no free colour is solved before the colours, one at a time).
@@ -40,8 +40,8 @@ const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 /// fewer).
 const MIN_COLOURED_ISLAND: usize = 48;
 
-/// One step of the passes' work, in order: a batch of four two-point manifolds, a batch
-/// of four one-point ones, or one manifold (`(first point, point count)`) solved alone.
+/// One step of the passes' work, in order: a batch of eight two-point manifolds, a batch
+/// of eight one-point ones, or one manifold (`(first point, point count)`) solved alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum PassItem {
     Batch(u32),
@@ -224,7 +224,7 @@ impl<const N: usize> BatchPool<N> {
     }
 
     /// Takes the manifold at `first` into the colour's next batch, which goes into
-    /// `items` once it holds four.
+    /// `items` once it holds `LANES`.
     fn take(
         &mut self,
         first: u32,
@@ -261,7 +261,7 @@ impl<const N: usize> BatchPool<N> {
 /// One point of each lane's manifold.
 #[derive(Debug, Clone, Copy, Default)]
 #[repr(C)]
-struct LanePoints<L = F64x4> {
+struct LanePoints<L = F64x8> {
     normal_lever_a: L,
     normal_lever_b: L,
     reach_a: L,
@@ -277,20 +277,21 @@ struct LanePoints<L = F64x4> {
 /// `LanePoints` so that a batch of points that cannot bounce (a pile) never touches it.
 #[derive(Debug, Clone, Copy, Default)]
 #[repr(C)]
-struct LaneBounce<L = F64x4> {
+struct LaneBounce<L = F64x8> {
     restitution: L,
     relative_velocity: L,
     max_normal_impulse: L,
     closing_acceleration: L,
 }
 
-/// Four manifolds of `N` points (one or two) with no moving body in common, their data
+/// Eight manifolds of `N` points (one or two) with no moving body in common, their data
 /// lane by lane; each manifold's points stay in `points` too, which this batch updates at
-/// the end of the substeps. Stored with `F64x4` lanes; `repr(C)`, so that the AVX2 path
-/// reads the same bytes as `ManifoldBatch<N, F64x4Avx2>`.
+/// the end of the substeps. Stored with `F64x8` lanes; `repr(C)`, so that the AVX2 and
+/// AVX-512 paths read the same bytes as `ManifoldBatch<N, F64x8Avx2>` and
+/// `ManifoldBatch<N, F64x8Avx512>`.
 #[derive(Debug, Clone, Copy)]
 #[repr(C)]
-pub(super) struct ManifoldBatch<const N: usize, L = F64x4> {
+pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     /// The first of each lane's points in `points`.
     first_point: [u32; LANES],
     a: [u32; LANES],
@@ -315,15 +316,19 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x4> {
 #[cfg(target_arch = "x86_64")]
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x4Avx2>>());
-    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x4Avx2>>());
-    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x4Avx2>>());
-    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, F64x4Avx2>>());
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx2>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx2>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx2>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, F64x8Avx2>>());
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx512>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx512>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx512>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, F64x8Avx512>>());
 };
 
 impl<const N: usize> Default for ManifoldBatch<N> {
     fn default() -> Self {
-        let zero = F64x4::default();
+        let zero = F64x8::default();
         Self {
             first_point: [0; LANES],
             a: [0; LANES],
@@ -422,61 +427,141 @@ pub(super) struct PassSettings {
     pub use_bias: bool,
 }
 
+/// The lanes a batch is solved with: the widest this processor has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum LanePath {
+    /// `F64x8`: plain arrays, any processor.
+    Portable,
+    /// `F64x8Avx2`: two 256-bit registers.
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
+    /// `F64x8Avx512`: one 512-bit register.
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
+}
+
+impl LanePath {
+    /// The widest path this processor runs (detected once, then a cached flag).
+    #[inline(always)]
+    pub(super) fn best() -> Self {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Self::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Self::Avx2;
+            }
+        }
+        Self::Portable
+    }
+
+    /// Every path this processor runs, the portable one first.
+    #[cfg(test)]
+    pub(super) fn available() -> Vec<Self> {
+        let mut paths = vec![Self::Portable];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                paths.push(Self::Avx2);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                paths.push(Self::Avx512);
+            }
+        }
+        paths
+    }
+}
+
 impl<const N: usize> ManifoldBatch<N> {
     /// `warm_start` for the batch's points.
+    #[inline(always)]
     pub(super) fn warm_start(&self, bodies: &mut [SoftBody]) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: this processor has AVX2, just checked.
-            return unsafe { self.warm_start_avx2(bodies) };
-        }
-        self.warm_start_lanes(bodies)
+        self.warm_start_on(LanePath::best(), bodies)
     }
 
     /// `solve_pair` (or `solve_point`) on every lane.
+    #[inline(always)]
     pub(super) fn solve(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: this processor has AVX2, just checked.
-            return unsafe { self.solve_avx2(bodies, pass) };
-        }
-        self.solve_lanes(bodies, pass)
+        self.solve_on(LanePath::best(), bodies, pass)
     }
 
-    /// The batch as AVX2 registers: the same bytes (`repr(C)`, lanes of one size and
-    /// alignment, asserted above; any bits are valid in either).
+    /// `warm_start` with the lanes of `path`, which this processor must run.
+    pub(super) fn warm_start_on(&self, path: LanePath, bodies: &mut [SoftBody]) {
+        match path {
+            LanePath::Portable => self.warm_start_lanes(bodies),
+            // SAFETY: `path` is one this processor runs (`LanePath::best`, `available`).
+            #[cfg(target_arch = "x86_64")]
+            LanePath::Avx2 => unsafe { self.warm_start_avx2(bodies) },
+            #[cfg(target_arch = "x86_64")]
+            LanePath::Avx512 => unsafe { self.warm_start_avx512(bodies) },
+        }
+    }
+
+    /// `solve` with the lanes of `path`, which this processor must run.
+    pub(super) fn solve_on(
+        &mut self,
+        path: LanePath,
+        bodies: &mut [SoftBody],
+        pass: &PassSettings,
+    ) {
+        match path {
+            LanePath::Portable => self.solve_lanes(bodies, pass),
+            // SAFETY: as in `warm_start_on`.
+            #[cfg(target_arch = "x86_64")]
+            LanePath::Avx2 => unsafe { self.solve_avx2(bodies, pass) },
+            #[cfg(target_arch = "x86_64")]
+            LanePath::Avx512 => unsafe { self.solve_avx512(bodies, pass) },
+        }
+    }
+
+    /// The batch read with the lane type `L`: the same bytes (`repr(C)`, lanes of one
+    /// size and alignment, asserted above; any bits are valid in each).
     ///
     /// # Safety
-    /// The processor must have AVX2: every operation on the result is an AVX2 instruction.
-    #[cfg(target_arch = "x86_64")]
+    /// The processor must run `L`'s instructions.
     #[inline(always)]
-    unsafe fn as_avx2(&self) -> &ManifoldBatch<N, F64x4Avx2> {
+    unsafe fn as_lanes<L: Lanes>(&self) -> &ManifoldBatch<N, L> {
         // SAFETY: see above; the borrow is `self`'s.
-        unsafe { &*(self as *const Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
+        unsafe { &*(self as *const Self).cast::<ManifoldBatch<N, L>>() }
     }
 
     /// # Safety
-    /// As `as_avx2`.
-    #[cfg(target_arch = "x86_64")]
+    /// As `as_lanes`.
     #[inline(always)]
-    unsafe fn as_avx2_mut(&mut self) -> &mut ManifoldBatch<N, F64x4Avx2> {
-        // SAFETY: as `as_avx2`.
-        unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, F64x4Avx2>>() }
+    unsafe fn as_lanes_mut<L: Lanes>(&mut self) -> &mut ManifoldBatch<N, L> {
+        // SAFETY: as `as_lanes`.
+        unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, L>>() }
     }
 
-    /// The same code compiled for AVX2, whose 256-bit registers hold the four lanes.
+    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes each.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        // SAFETY: this function runs only where the processor has AVX2 (`warm_start`).
-        unsafe { self.as_avx2() }.warm_start_lanes(bodies)
+        // SAFETY: this function runs only where the processor has AVX2 (`warm_start_on`).
+        unsafe { self.as_lanes::<F64x8Avx2>() }.warm_start_lanes(bodies)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        // SAFETY: this function runs only where the processor has AVX2 (`solve`).
-        unsafe { self.as_avx2_mut() }.solve_lanes(bodies, pass)
+        // SAFETY: this function runs only where the processor has AVX2 (`solve_on`).
+        unsafe { self.as_lanes_mut::<F64x8Avx2>() }.solve_lanes(bodies, pass)
+    }
+
+    /// The same code compiled for AVX-512, whose 512-bit registers hold all eight lanes.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn warm_start_avx512(&self, bodies: &mut [SoftBody]) {
+        // SAFETY: this function runs only where the processor has AVX-512F.
+        unsafe { self.as_lanes::<F64x8Avx512>() }.warm_start_lanes(bodies)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f")]
+    fn solve_avx512(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
+        // SAFETY: this function runs only where the processor has AVX-512F.
+        unsafe { self.as_lanes_mut::<F64x8Avx512>() }.solve_lanes(bodies, pass)
     }
 
     /// Fills the batch with the manifolds whose first points are `first_point`.
@@ -892,13 +977,22 @@ mod tests {
         }
     }
 
-    /// Four two-point manifolds: lanes 0 and 1 between moving bodies, lanes 2 and 3 each
+    /// Eight two-point manifolds: lanes 0–5 between moving bodies, lanes 6 and 7 each
     /// against the same fixed body (which lanes may share).
-    fn four_manifolds(seed: u64) -> (Vec<SoftBody>, Vec<PointConstraint>) {
+    fn eight_manifolds(seed: u64) -> (Vec<SoftBody>, Vec<PointConstraint>) {
         let mut n = Numbers(seed);
-        let mut bodies: Vec<SoftBody> = (0..6).map(|_| body(&mut n, true)).collect();
+        let mut bodies: Vec<SoftBody> = (0..14).map(|_| body(&mut n, true)).collect();
         bodies.push(body(&mut n, false));
-        let pairs = [(0, 1), (2, 3), (4, 6), (6, 5)];
+        let pairs = [
+            (0, 1),
+            (2, 3),
+            (4, 5),
+            (6, 7),
+            (8, 9),
+            (10, 11),
+            (12, 14),
+            (14, 13),
+        ];
         let mut points = Vec::new();
         for (a, b) in pairs {
             let angle = n.next(0.0, std::f64::consts::TAU);
@@ -917,10 +1011,10 @@ mod tests {
         }
     }
 
-    const FIRSTS: [u32; LANES] = [0, 2, 4, 6];
+    const FIRSTS: [u32; LANES] = [0, 2, 4, 6, 8, 10, 12, 14];
 
     /// Velocities and impulses: what a pass changes (and the inverse masses, which the
-    /// AVX2 path writes back beside the velocities).
+    /// SIMD paths write back beside the velocities).
     /// As bits, so that even the sign of a zero counts.
     fn state(bodies: &[SoftBody], points: &[PointConstraint]) -> Vec<u64> {
         let v = bodies.iter().flat_map(|b| [b.v.x, b.v.y, b.w, b.inv_mass]);
@@ -935,10 +1029,9 @@ mod tests {
         v.chain(p).map(f64::to_bits).collect()
     }
 
-    /// Solves the manifolds starting at `firsts` as one batch, through `solve` (AVX2
-    /// where the processor has it) and through the code compiled without it, and checks
-    /// that both leave exactly the `expected` state: each lane runs the scalar arithmetic
-    /// in the scalar order.
+    /// Solves the manifolds starting at `firsts` as one batch, with every lane path this
+    /// processor runs (AVX-512, AVX2, portable), and checks that each leaves exactly the
+    /// `expected` state: each lane runs the scalar arithmetic in the scalar order.
     fn assert_batch_gives<const N: usize>(
         (bodies, points): (&[SoftBody], &[PointConstraint]),
         firsts: [u32; LANES],
@@ -946,26 +1039,21 @@ mod tests {
         expected: &[u64],
         label: &str,
     ) {
-        for dispatched in [true, false] {
+        for path in LanePath::available() {
             let mut batch = ManifoldBatch::<N>::default();
             batch.fill(firsts, points, bodies);
             let (mut lanes, mut lane_points) = (bodies.to_vec(), points.to_vec());
-            if dispatched {
-                batch.solve(&mut lanes, pass);
-            } else {
-                batch.solve_lanes(&mut lanes, pass);
-            }
+            batch.solve_on(path, &mut lanes, pass);
             batch.scatter(&mut lane_points);
-            let path = if dispatched { "dispatched" } else { "generic" };
-            assert_eq!(state(&lanes, &lane_points), expected, "{label}, {path}");
+            assert_eq!(state(&lanes, &lane_points), expected, "{label}, {path:?}");
         }
     }
 
-    /// `four_manifolds(k)` for `seed` 2k − 1 and 2k, the odd one with every point made
+    /// `eight_manifolds(k)` for `seed` 2k − 1 and 2k, the odd one with every point made
     /// unable to bounce (a pile's): the batch then leaves its bounce lanes alone, as the
     /// scalar code leaves such points' approach and largest push.
-    fn four_manifolds_both_ways(seed: u64) -> (Vec<SoftBody>, Vec<PointConstraint>) {
-        let (bodies, mut points) = four_manifolds(seed.div_ceil(2));
+    fn eight_manifolds_both_ways(seed: u64) -> (Vec<SoftBody>, Vec<PointConstraint>) {
+        let (bodies, mut points) = eight_manifolds(seed.div_ceil(2));
         if seed % 2 == 1 {
             for p in &mut points {
                 p.restitution = 0.0;
@@ -977,7 +1065,7 @@ mod tests {
     #[test]
     fn a_batch_solves_as_its_manifolds_one_after_another() {
         for seed in 1..=398u64 {
-            let (bodies, points) = four_manifolds_both_ways(seed);
+            let (bodies, points) = eight_manifolds_both_ways(seed);
             for use_bias in [true, false] {
                 let pass = pass(use_bias);
                 let (mut one_by_one, mut their_points) = (bodies.clone(), points.clone());
@@ -999,8 +1087,8 @@ mod tests {
     #[test]
     fn a_batch_of_one_point_manifolds_solves_as_they_do_one_after_another() {
         for seed in 1..=398u64 {
-            // The first point of each of four manifolds, each alone.
-            let (bodies, pairs) = four_manifolds_both_ways(seed);
+            // The first point of each of eight manifolds, each alone.
+            let (bodies, pairs) = eight_manifolds_both_ways(seed);
             let points: Vec<PointConstraint> = pairs
                 .iter()
                 .step_by(2)
@@ -1009,7 +1097,7 @@ mod tests {
                     ..*p
                 })
                 .collect();
-            let firsts = [0, 1, 2, 3];
+            let firsts = [0, 1, 2, 3, 4, 5, 6, 7];
             for use_bias in [true, false] {
                 let pass = pass(use_bias);
                 let (mut one_by_one, mut their_points) = (bodies.clone(), points.clone());
@@ -1026,18 +1114,19 @@ mod tests {
     #[test]
     fn a_batch_warm_starts_as_its_points_one_after_another() {
         for seed in 1..50 {
-            let (bodies, points) = four_manifolds(seed);
+            let (bodies, points) = eight_manifolds(seed);
             let mut one_by_one = bodies.clone();
             for p in &points {
                 warm_start_point(&mut one_by_one, p);
             }
             let mut batch = ManifoldBatch::<2>::default();
             batch.fill(FIRSTS, &points, &bodies);
-            let (mut lanes, mut generic) = (bodies.clone(), bodies.clone());
-            batch.warm_start(&mut lanes);
-            batch.warm_start_lanes(&mut generic);
-            assert_eq!(state(&lanes, &[]), state(&one_by_one, &[]), "seed {seed}");
-            assert_eq!(state(&generic, &[]), state(&one_by_one, &[]), "seed {seed}");
+            for path in LanePath::available() {
+                let mut lanes = bodies.clone();
+                batch.warm_start_on(path, &mut lanes);
+                let expected = state(&one_by_one, &[]);
+                assert_eq!(state(&lanes, &[]), expected, "seed {seed}, {path:?}");
+            }
         }
     }
 
@@ -1103,9 +1192,9 @@ mod tests {
         }
         assert_eq!(seen, expected);
         let (batches, point_batches) = (plan.batches().len(), plan.point_batches().len());
-        assert!(batches >= 10, "{batches} batches of 52 two-point manifolds");
+        assert!(batches >= 5, "{batches} batches of 52 two-point manifolds");
         assert!(
-            point_batches >= 8,
+            point_batches >= 3,
             "{point_batches} batches of 54 one-point ones"
         );
         // Every contact with the floor after every contact between boxes.

@@ -1,14 +1,18 @@
-//! Four f64 lanes, as the batches compute with them (`Lanes`): `F64x4`, plain arrays that
-//! the compiler vectorises, on any processor; and `avx2::F64x4Avx2`, the same numbers in
-//! a 256-bit register, inside the functions compiled for AVX2 (chosen at run time, see
-//! `ManifoldBatch::solve`). Every lane rounds as the scalar code does, so both give the
-//! same bits.
+//! Eight f64 lanes, as the batches compute with them (`Lanes`): `F64x8`, plain arrays that
+//! the compiler vectorises, on any processor; `avx2::F64x8Avx2`, the same numbers in two
+//! 256-bit registers, inside the functions compiled for AVX2; and `avx512::F64x8Avx512`,
+//! in one 512-bit register, inside those compiled for AVX-512 (chosen at run time, see
+//! `ManifoldBatch::solve`). Every lane rounds as the scalar code does, so all three give
+//! the same bits.
 
 use super::{BodyRow, SoftBody};
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 
-/// Four lanes of f64 and what the batches do with them. A batch is stored with
-/// `F64x4`s and read as either implementation (they share its layout).
+/// How many manifolds a batch holds, one a lane.
+pub(super) const LANES: usize = 8;
+
+/// Eight lanes of f64 and what the batches do with them. A batch is stored with
+/// `F64x8`s and read as any implementation (they share its layout).
 pub(super) trait Lanes:
     Copy
     + Add<Output = Self>
@@ -33,14 +37,14 @@ pub(super) trait Lanes:
     fn lt(self, rhs: Self) -> Self::Mask;
     fn eq(self, rhs: Self) -> Self::Mask;
     fn ne(self, rhs: Self) -> Self::Mask;
-    /// The row `row` of the four bodies `index` names, one body a lane: its four
-    /// numbers as four columns (`SoftBody::row`).
-    fn gather(bodies: &[SoftBody], index: &[u32; 4], row: BodyRow) -> [Self; 4];
+    /// The row `row` of the bodies `index` names, one body a lane: its four numbers as
+    /// four columns (`SoftBody::row`).
+    fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4];
     /// Writes the velocity row's first three columns back, lane 0 first, so that a fixed
     /// body in several lanes of one side keeps the last lane's, as the scalar lane-by-lane
     /// stores left it (it can differ only in the sign of a zero); the fourth column must
     /// be the inverse masses `gather` read.
-    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]);
+    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]);
 }
 
 /// A lane-wise condition of `L`'s lanes.
@@ -51,15 +55,15 @@ pub(super) trait LaneMask<L>: Copy + BitAnd<Output = Self> + BitXor<Output = Sel
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[repr(C, align(32))]
-pub(super) struct F64x4(pub [f64; 4]);
+#[repr(C, align(64))]
+pub(super) struct F64x8(pub [f64; LANES]);
 
 /// A lane-wise condition, each lane all ones or all zeros as a vector comparison leaves
 /// it, so that choosing by it is one blend (a `bool` per lane cost conversions both ways).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Mask4([u64; 4]);
+pub(super) struct Mask8([u64; LANES]);
 
-impl F64x4 {
+impl F64x8 {
     #[inline(always)]
     pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
         Self(std::array::from_fn(f))
@@ -71,19 +75,19 @@ impl F64x4 {
     }
 
     #[inline(always)]
-    fn compare(self, rhs: Self, f: impl Fn(f64, f64) -> bool) -> Mask4 {
-        Mask4(std::array::from_fn(|k| {
+    fn compare(self, rhs: Self, f: impl Fn(f64, f64) -> bool) -> Mask8 {
+        Mask8(std::array::from_fn(|k| {
             if f(self.0[k], rhs.0[k]) { u64::MAX } else { 0 }
         }))
     }
 }
 
-impl Lanes for F64x4 {
-    type Mask = Mask4;
+impl Lanes for F64x8 {
+    type Mask = Mask8;
 
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Self([x; 4])
+        Self([x; LANES])
     }
 
     #[inline(always)]
@@ -108,39 +112,39 @@ impl Lanes for F64x4 {
     }
 
     #[inline(always)]
-    fn gt(self, rhs: Self) -> Mask4 {
+    fn gt(self, rhs: Self) -> Mask8 {
         self.compare(rhs, |a, b| a > b)
     }
 
     #[inline(always)]
-    fn ge(self, rhs: Self) -> Mask4 {
+    fn ge(self, rhs: Self) -> Mask8 {
         self.compare(rhs, |a, b| a >= b)
     }
 
     #[inline(always)]
-    fn lt(self, rhs: Self) -> Mask4 {
+    fn lt(self, rhs: Self) -> Mask8 {
         self.compare(rhs, |a, b| a < b)
     }
 
     #[inline(always)]
-    fn eq(self, rhs: Self) -> Mask4 {
+    fn eq(self, rhs: Self) -> Mask8 {
         self.compare(rhs, |a, b| a == b)
     }
 
     #[inline(always)]
-    fn ne(self, rhs: Self) -> Mask4 {
+    fn ne(self, rhs: Self) -> Mask8 {
         self.compare(rhs, |a, b| a != b)
     }
 
     #[inline(always)]
-    fn gather(bodies: &[SoftBody], index: &[u32; 4], row: BodyRow) -> [Self; 4] {
-        let rows = [0, 1, 2, 3].map(|k| bodies[index[k] as usize].row(row));
+    fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4] {
+        let rows = index.map(|i| bodies[i as usize].row(row));
         std::array::from_fn(|c| Self::from_fn(|k| rows[k][c]))
     }
 
     #[inline(always)]
-    fn scatter_velocities([x, y, w, _]: [Self; 4], bodies: &mut [SoftBody], index: &[u32; 4]) {
-        for k in 0..4 {
+    fn scatter_velocities([x, y, w, _]: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]) {
+        for k in 0..LANES {
             let body = &mut bodies[index[k] as usize];
             body.v.x = x.0[k];
             body.v.y = y.0[k];
@@ -149,22 +153,22 @@ impl Lanes for F64x4 {
     }
 }
 
-impl LaneMask<F64x4> for Mask4 {
+impl LaneMask<F64x8> for Mask8 {
     #[inline(always)]
     fn any(self) -> bool {
         self.0.iter().fold(0, |any, &m| any | m) != 0
     }
 
     #[inline(always)]
-    fn select(self, if_true: F64x4, if_false: F64x4) -> F64x4 {
-        F64x4::from_fn(|k| {
+    fn select(self, if_true: F64x8, if_false: F64x8) -> F64x8 {
+        F64x8::from_fn(|k| {
             let m = self.0[k];
             f64::from_bits((if_true.0[k].to_bits() & m) | (if_false.0[k].to_bits() & !m))
         })
     }
 }
 
-impl BitAnd for Mask4 {
+impl BitAnd for Mask8 {
     type Output = Self;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
@@ -172,7 +176,7 @@ impl BitAnd for Mask4 {
     }
 }
 
-impl BitXor for Mask4 {
+impl BitXor for Mask8 {
     type Output = Self;
     #[inline(always)]
     fn bitxor(self, rhs: Self) -> Self {
@@ -182,7 +186,7 @@ impl BitXor for Mask4 {
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $op:tt) => {
-        impl $trait for F64x4 {
+        impl $trait for F64x8 {
             type Output = Self;
             #[inline(always)]
             fn $method(self, rhs: Self) -> Self {
@@ -190,7 +194,7 @@ macro_rules! lane_op {
             }
         }
 
-        impl $assign_trait for F64x4 {
+        impl $assign_trait for F64x8 {
             #[inline(always)]
             fn $assign(&mut self, rhs: Self) {
                 *self = *self $op rhs;
@@ -202,7 +206,7 @@ macro_rules! lane_op {
 lane_op!(Add, add, AddAssign, add_assign, +);
 lane_op!(Sub, sub, SubAssign, sub_assign, -);
 
-impl Mul for F64x4 {
+impl Mul for F64x8 {
     type Output = Self;
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
@@ -210,7 +214,7 @@ impl Mul for F64x4 {
     }
 }
 
-impl Neg for F64x4 {
+impl Neg for F64x8 {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
