@@ -64,6 +64,34 @@ pub(super) struct PassPlan {
     /// starts in it.
     by_colour: Vec<(u32, u32, u32)>,
     colour_starts: Vec<u32>,
+    /// What the last plan was made from, one entry a manifold (`PlanInput`): while it
+    /// is unchanged, so is the plan, and only the batches' numbers are read again.
+    inputs: Vec<PlanInput>,
+    last_inputs: Vec<PlanInput>,
+}
+
+/// What planning reads of one manifold: its bodies, first point, and `PlanInput::flags`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct PlanInput {
+    a: u32,
+    b: u32,
+    first: u32,
+    flags: u32,
+}
+
+impl PlanInput {
+    const TWO_POINTS: u32 = 1;
+    const COLOURED: u32 = 2;
+    const A_MOVES: u32 = 4;
+    const B_MOVES: u32 = 8;
+
+    fn count(self) -> u32 {
+        if self.flags & Self::TWO_POINTS != 0 {
+            2
+        } else {
+            1
+        }
+    }
 }
 
 impl PassPlan {
@@ -75,31 +103,31 @@ impl PassPlan {
         points: &[PointConstraint],
         bodies: &[SoftBody],
     ) {
+        self.read_inputs(islands, points, bodies);
+        if self.inputs == self.last_inputs {
+            // A pile at rest: the same manifolds between the same bodies.
+            for batch in self.pairs.filled_mut() {
+                batch.fill(batch.first_point, points, bodies);
+            }
+            for batch in self.singles.filled_mut() {
+                batch.fill(batch.first_point, points, bodies);
+            }
+            return;
+        }
         self.items.clear();
         self.pairs.clear();
         self.singles.clear();
         self.coloured.clear();
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
-        for &(start, end) in islands {
-            if points[start].in_lcp {
-                continue;
-            }
-            let colour = end - start >= MIN_COLOURED_ISLAND;
-            let mut first = start;
-            while first < end {
-                let count = if points[first].pair_coupling.is_some() {
-                    2
-                } else {
-                    1
-                };
-                if colour {
-                    let c = self.colour_of(&points[first], bodies);
-                    self.coloured.push((c, first as u32, count));
-                } else {
-                    self.items.push(PassItem::Manifold(first as u32, count));
-                }
-                first += count as usize;
+        for k in 0..self.inputs.len() {
+            let input = self.inputs[k];
+            if input.flags & PlanInput::COLOURED != 0 {
+                let c = self.colour_of(input);
+                self.coloured.push((c, input.first, input.count()));
+            } else {
+                self.items
+                    .push(PassItem::Manifold(input.first, input.count()));
             }
         }
         // Grouped by colour, each colour in the points' order (a counting sort: the
@@ -130,6 +158,47 @@ impl PassPlan {
             }
             self.pairs.end_colour(&mut self.items);
             self.singles.end_colour(&mut self.items);
+        }
+        std::mem::swap(&mut self.inputs, &mut self.last_inputs);
+    }
+
+    /// What `plan` reads of each manifold outside the LCP islands, into `inputs`.
+    fn read_inputs(
+        &mut self,
+        islands: &[(usize, usize)],
+        points: &[PointConstraint],
+        bodies: &[SoftBody],
+    ) {
+        self.inputs.clear();
+        for &(start, end) in islands {
+            if points[start].in_lcp {
+                continue;
+            }
+            let coloured = if end - start >= MIN_COLOURED_ISLAND {
+                PlanInput::COLOURED
+            } else {
+                0
+            };
+            let mut first = start;
+            while first < end {
+                let p = &points[first];
+                let moves = |i: u32, flag: u32| if bodies[i as usize].moves() { flag } else { 0 };
+                let input = PlanInput {
+                    a: p.a,
+                    b: p.b,
+                    first: first as u32,
+                    flags: coloured
+                        | if p.pair_coupling.is_some() {
+                            PlanInput::TWO_POINTS
+                        } else {
+                            0
+                        }
+                        | moves(p.a, PlanInput::A_MOVES)
+                        | moves(p.b, PlanInput::B_MOVES),
+                };
+                self.inputs.push(input);
+                first += input.count() as usize;
+            }
         }
     }
 
@@ -170,10 +239,13 @@ impl PassPlan {
 
     /// A manifold's colour, counted from 1 (0: none free, solved first), marking it taken
     /// for its moving bodies.
-    fn colour_of(&mut self, p: &PointConstraint, bodies: &[SoftBody]) -> u32 {
-        let moving = |i: u32| bodies[i as usize].moves();
-        let (a, b) = (p.a as usize, p.b as usize);
-        let free = match (moving(p.a), moving(p.b)) {
+    fn colour_of(&mut self, input: PlanInput) -> u32 {
+        let (a, b) = (input.a as usize, input.b as usize);
+        let (a_moves, b_moves) = (
+            input.flags & PlanInput::A_MOVES != 0,
+            input.flags & PlanInput::B_MOVES != 0,
+        );
+        let free = match (a_moves, b_moves) {
             (true, true) => {
                 let c = (self.colours_of[a] | self.colours_of[b]).trailing_ones();
                 (c < DYNAMIC_COLOURS).then_some(c)
@@ -183,7 +255,7 @@ impl PassPlan {
             (false, false) => None,
         };
         let Some(c) = free else { return 0 };
-        for (body, is_moving) in [(a, moving(p.a)), (b, moving(p.b))] {
+        for (body, is_moving) in [(a, a_moves), (b, b_moves)] {
             if is_moving {
                 self.colours_of[body] |= 1 << c;
             }
@@ -1201,6 +1273,20 @@ mod tests {
         let on_floor = |f: &u32| points[*f as usize].a == 0;
         let first_on_floor = order.iter().position(on_floor).unwrap();
         assert!(order[first_on_floor..].iter().all(on_floor), "{order:?}");
+        // Planned again from the same manifolds, the plan is kept and its batches read
+        // the points' current numbers; from changed ones, it is the fresh plan.
+        let kept = plan.items.clone();
+        let batched = plan.batches()[0].first_point[3] as usize;
+        points[batched].normal_impulse = 0.125;
+        plan.plan(&[(0, points.len())], &points, &bodies);
+        assert_eq!(plan.items, kept);
+        assert_eq!(plan.batches()[0].points[0].normal_impulse.0[3], 0.125);
+        points[batched].pair_coupling = None;
+        plan.plan(&[(0, points.len())], &points, &bodies);
+        let mut fresh = PassPlan::default();
+        fresh.plan(&[(0, points.len())], &points, &bodies);
+        assert_ne!(plan.items, kept);
+        assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
         let (bodies, points) = row_on_floor(10);
         plan.plan(&[(0, 38)], &points, &bodies);
