@@ -341,7 +341,6 @@ struct LanePoints<L = F64x8> {
     base_separation: L,
     normal_mass: L,
     tangent_mass: L,
-    normal_impulse: L,
     tangent_impulse: L,
 }
 
@@ -382,6 +381,9 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     /// The inverse of the 2 × 2 block, `[i11, i12, i22]` (two-point manifolds only).
     inverse: [L; 3],
     points: [LanePoints<L>; N],
+    /// Each point's accumulated normal impulse, apart from `points` so that a lane
+    /// solved both ways (`solve_normals_together`) copies only these.
+    normal_impulses: [L; N],
     bounce: [LaneBounce<L>; N],
 }
 
@@ -416,6 +418,7 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             inverse: [zero; 3],
             may_bounce: false,
             points: [LanePoints::default(); N],
+            normal_impulses: [zero; N],
             bounce: [LaneBounce::default(); N],
         }
     }
@@ -659,7 +662,9 @@ impl<const N: usize> ManifoldBatch<N> {
                 self.inverse[1].0[k] = block.inverse.1;
                 self.inverse[2].0[k] = block.inverse.2;
             }
-            for (lane, p) in self.points.iter_mut().zip(&points[first as usize..]) {
+            let lanes = self.points.iter_mut().zip(&mut self.normal_impulses);
+            for ((lane, impulse), p) in lanes.zip(&points[first as usize..]) {
+                impulse.0[k] = p.normal_impulse;
                 lane.normal_lever_a.0[k] = p.levers.normal.0;
                 lane.normal_lever_b.0[k] = p.levers.normal.1;
                 lane.reach_a.0[k] = p.levers.reach.0;
@@ -667,7 +672,6 @@ impl<const N: usize> ManifoldBatch<N> {
                 lane.base_separation.0[k] = p.base_separation;
                 lane.normal_mass.0[k] = p.normal_mass;
                 lane.tangent_mass.0[k] = p.tangent_mass;
-                lane.normal_impulse.0[k] = p.normal_impulse;
                 lane.tangent_impulse.0[k] = p.tangent_impulse;
             }
             for (lane, p) in self.bounce.iter_mut().zip(&points[first as usize..]) {
@@ -683,7 +687,7 @@ impl<const N: usize> ManifoldBatch<N> {
     /// Writes what the passes changed back to the batch's points.
     pub(super) fn scatter(&self, points: &mut [PointConstraint]) {
         for (which, (lp, lb)) in self.points.iter().zip(&self.bounce).enumerate() {
-            let normal = lp.normal_impulse.0;
+            let normal = self.normal_impulses[which].0;
             let tangent = lp.tangent_impulse.0;
             let max_normal = lb.max_normal_impulse.0;
             let relative = lb.relative_velocity.0;
@@ -723,8 +727,8 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let mut pair = self.load(bodies);
         let normal = (self.normal_x, self.normal_y);
         let tangent = (-self.normal_y, self.normal_x);
-        for p in &self.points {
-            pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, p.normal_impulse);
+        for (p, &impulse) in self.points.iter().zip(&self.normal_impulses) {
+            pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, impulse);
             // The tangent row's levers are the reaches (`PointLevers::tangent`).
             pair.apply_along(tangent, p.reach_a, p.reach_b, p.tangent_impulse);
         }
@@ -788,13 +792,13 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             self.solve_normals_together(&mut pair, &separations, &targets, pass);
         } else {
             let bounce = self.may_bounce.then_some(&mut self.bounce[..]);
-            let points = (&mut self.points[..], bounce);
+            let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
             solve_normals_alone(&mut pair, points, normal, &separations, &targets);
         }
         let tangent = (-self.normal_y, self.normal_x);
-        for p in &mut self.points {
+        for (p, &normal_impulse) in self.points.iter_mut().zip(&self.normal_impulses) {
             let vt = pair.velocity_along(tangent, p.reach_a, p.reach_b);
-            let limit = self.friction * p.normal_impulse;
+            let limit = self.friction * normal_impulse;
             let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
             let delta = total - p.tangent_impulse;
             p.tangent_impulse = total;
@@ -819,12 +823,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
         let soft_differs =
             pass.use_bias && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
-        // Copied only when needed (a batch's points are 1,000 bytes).
-        let one_by_one = if soft_differs && mixed.any() {
-            Some((*pair, self.points, self.bounce))
-        } else {
-            None
-        };
+        // Copied only when needed: the velocities and impulses, and the bounce lanes of a
+        // batch that may bounce.
+        let one_by_one = (soft_differs && mixed.any()).then(|| {
+            let bounce = self.may_bounce.then_some(self.bounce);
+            (*pair, self.normal_impulses, bounce)
+        });
         let points = &self.points[..];
         let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
         let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
@@ -833,15 +837,15 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             approach(&mut self.bounce[1], v2, separations[1]);
         }
         self.solve_block(pair, [v1, v2], [targets[0], targets[1]]);
-        if let Some((mut alone, mut points, mut bounce)) = one_by_one {
-            let alone_bounce = self.may_bounce.then_some(&mut bounce[..]);
-            let alone_points = (&mut points[..], alone_bounce);
+        if let Some((mut alone, mut impulses, mut bounce)) = one_by_one {
+            let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
+            let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
             solve_normals_alone(&mut alone, alone_points, normal, separations, targets);
             *pair = LanePair::select(mixed, alone, *pair);
-            for (p, q) in self.points.iter_mut().zip(points) {
-                p.normal_impulse = mixed.select(q.normal_impulse, p.normal_impulse);
+            for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
+                *p = mixed.select(q, *p);
             }
-            if self.may_bounce {
+            if let Some(bounce) = bounce {
                 for (p, q) in self.bounce.iter_mut().zip(bounce) {
                     p.max_normal_impulse = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
                     p.relative_velocity = mixed.select(q.relative_velocity, p.relative_velocity);
@@ -861,7 +865,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     ) {
         let zero = L::splat(0.0);
         let points = &self.points[..];
-        let (x1, x2) = (points[0].normal_impulse, points[1].normal_impulse);
+        let [x1, x2] = [self.normal_impulses[0], self.normal_impulses[1]];
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
         let spring12 = k12.min(zero);
         let r1 = ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2);
@@ -880,9 +884,15 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         );
         let normal = (self.normal_x, self.normal_y);
         let may_bounce = self.may_bounce;
-        let points = self.points.iter_mut().zip(&mut self.bounce);
-        for ((p, bounce), total) in points.zip([total1, total2]) {
-            apply_normal(pair, p, may_bounce.then_some(bounce), normal, total);
+        let points = self.points.iter().zip(&mut self.normal_impulses);
+        for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
+            apply_normal(
+                pair,
+                (p, impulse),
+                may_bounce.then_some(bounce),
+                normal,
+                total,
+            );
         }
     }
 }
@@ -891,28 +901,33 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
 /// lane.
 type Target<L> = (L, L, L);
 
-/// A batch's points, with their bounce lanes where some lane may bounce.
-type PointsOf<'a, L> = (&'a mut [LanePoints<L>], Option<&'a mut [LaneBounce<L>]>);
+/// A batch's points, their normal impulses, and their bounce lanes where some lane may
+/// bounce.
+type PointsOf<'a, L> = (
+    &'a [LanePoints<L>],
+    &'a mut [L],
+    Option<&'a mut [LaneBounce<L>]>,
+);
 
 /// `solve_normal` on every lane, point after point.
 #[inline(always)]
 fn solve_normals_alone<L: Lanes>(
     pair: &mut LanePair<L>,
-    (points, mut bounce): PointsOf<L>,
+    (points, impulses, mut bounce): PointsOf<L>,
     normal: (L, L),
     separations: &[L],
     targets: &[Target<L>],
 ) {
-    for (k, p) in points.iter_mut().enumerate() {
+    for (k, (p, impulse)) in points.iter().zip(impulses).enumerate() {
         let (target, mass_scale, impulse_scale) = targets[k];
         let vn = pair.velocity_along(normal, p.normal_lever_a, p.normal_lever_b);
         let mut bounce = bounce.as_deref_mut().map(|b| &mut b[k]);
         if let Some(b) = bounce.as_deref_mut() {
             approach(b, vn, separations[k]);
         }
-        let impulse =
-            -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
-        apply_normal(pair, p, bounce, normal, p.normal_impulse + impulse);
+        let accumulated = *impulse;
+        let change = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * accumulated;
+        apply_normal(pair, (p, impulse), bounce, normal, accumulated + change);
     }
 }
 
@@ -921,14 +936,14 @@ fn solve_normals_alone<L: Lanes>(
 #[inline(always)]
 fn apply_normal<L: Lanes>(
     pair: &mut LanePair<L>,
-    p: &mut LanePoints<L>,
+    (p, impulse): (&LanePoints<L>, &mut L),
     bounce: Option<&mut LaneBounce<L>>,
     normal: (L, L),
     total: L,
 ) {
     let total = total.max(L::splat(0.0));
-    let delta = total - p.normal_impulse;
-    p.normal_impulse = total;
+    let delta = total - *impulse;
+    *impulse = total;
     if let Some(b) = bounce {
         let elastic = b.restitution.ne(L::splat(0.0));
         b.max_normal_impulse =
@@ -1280,7 +1295,7 @@ mod tests {
         points[batched].normal_impulse = 0.125;
         plan.plan(&[(0, points.len())], &points, &bodies);
         assert_eq!(plan.items, kept);
-        assert_eq!(plan.batches()[0].points[0].normal_impulse.0[3], 0.125);
+        assert_eq!(plan.batches()[0].normal_impulses[0].0[3], 0.125);
         points[batched].pair_coupling = None;
         plan.plan(&[(0, points.len())], &points, &bodies);
         let mut fresh = PassPlan::default();
