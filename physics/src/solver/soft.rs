@@ -15,7 +15,7 @@ use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
-use batch::{PassItem, PassPlan, PassSettings};
+use batch::{PassItem, PassPlan, PassSettings, PlanInput};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -278,8 +278,10 @@ pub struct SoftStepSolver {
     grouped: Vec<(u32, u32)>,
     block: JointBlock,
     contact_lcp: ContactLcp,
-    /// The passes' order over the manifolds outside the LCP islands.
+    /// The passes' order over the manifolds outside the LCP islands, and what it is made
+    /// from: each manifold's entry, noted as its points are built.
     plan: PassPlan,
+    plan_inputs: Vec<PlanInput>,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
 }
@@ -373,6 +375,7 @@ impl SoftStepSolver {
             |i| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0,
         );
         island_ranges(grouped, &mut self.contact_islands);
+        self.plan_inputs.clear();
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -409,24 +412,39 @@ impl SoftStepSolver {
                 in_lcp: false,
                 pair_coupling: None,
             });
+            // With the point before, one manifold's two points: coupled if their block
+            // is well conditioned. Found here, while both are still in the cache.
+            let k = self.points.len() - 1;
+            let block = (k >= 1).then(|| {
+                let (p, q) = (&self.points[k - 1], &self.points[k]);
+                let same_manifold = p.a == q.a && p.b == q.b && p.normal == q.normal;
+                let taken = k >= 2 && self.points[k - 2].pair_coupling.is_some();
+                let bodies = (&self.bodies[p.a as usize], &self.bodies[p.b as usize]);
+                (same_manifold && !taken).then(|| NormalBlock::of(bodies, (p, q)))?
+            });
+            if let Some(block) = block.flatten() {
+                self.points[k - 1].pair_coupling = Some(block);
+                self.plan_inputs
+                    .last_mut()
+                    .expect("the first point's entry")
+                    .add_second_point();
+            } else {
+                let moves = |b: &SolverBody| b.inv_mass > 0.0 || b.inv_inertia > 0.0;
+                self.plan_inputs.push(PlanInput::new(
+                    (c.body_a, c.body_b),
+                    k,
+                    (moves(a), moves(b)),
+                ));
+            }
         }
         self.contact_lcp
             .prepare(&self.bodies, &mut self.points, &self.contact_islands);
-        for i in 1..self.points.len() {
-            let (p, q) = (&self.points[i - 1], &self.points[i]);
-            let same_manifold = p.a == q.a && p.b == q.b && p.normal == q.normal;
-            let taken = i >= 2 && self.points[i - 2].pair_coupling.is_some();
-            if !same_manifold || taken {
-                continue;
-            }
-            let block = NormalBlock::of(
-                (&self.bodies[p.a as usize], &self.bodies[p.b as usize]),
-                (p, q),
-            );
-            self.points[i - 1].pair_coupling = block;
-        }
-        self.plan
-            .plan(&self.contact_islands, &self.points, &self.bodies);
+        self.plan.plan(
+            &self.contact_islands,
+            &self.plan_inputs,
+            &self.points,
+            &self.bodies,
+        );
         self.joints.clear();
         self.skipped_joint_memory.clear();
         for (input, j) in joints.iter().enumerate() {

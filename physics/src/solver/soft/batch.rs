@@ -72,7 +72,7 @@ pub(super) struct PassPlan {
 
 /// What planning reads of one manifold: its bodies, first point, and `PlanInput::flags`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct PlanInput {
+pub(super) struct PlanInput {
     a: u32,
     b: u32,
     first: u32,
@@ -85,6 +85,22 @@ impl PlanInput {
     const A_MOVES: u32 = 4;
     const B_MOVES: u32 = 8;
 
+    /// A one-point manifold (so far) between `a` and `b`, whose point is `first`.
+    pub fn new((a, b): (u32, u32), first: usize, (a_moves, b_moves): (bool, bool)) -> Self {
+        let flag = |on: bool, flag: u32| if on { flag } else { 0 };
+        Self {
+            a,
+            b,
+            first: first as u32,
+            flags: flag(a_moves, Self::A_MOVES) | flag(b_moves, Self::B_MOVES),
+        }
+    }
+
+    /// The manifold's next point is coupled with its first: a two-point manifold.
+    pub fn add_second_point(&mut self) {
+        self.flags |= Self::TWO_POINTS;
+    }
+
     fn count(self) -> u32 {
         if self.flags & Self::TWO_POINTS != 0 {
             2
@@ -95,15 +111,17 @@ impl PlanInput {
 }
 
 impl PassPlan {
-    /// Plans the passes over `points`, grouped by `islands` (index ranges of `points`);
-    /// islands solved as one LCP are left out.
+    /// Plans the passes over `points`, grouped by `islands` (index ranges of `points`),
+    /// whose manifolds are `manifolds` in the points' order; islands solved as one LCP
+    /// are left out.
     pub fn plan(
         &mut self,
         islands: &[(usize, usize)],
+        manifolds: &[PlanInput],
         points: &[PointConstraint],
         bodies: &[SoftBody],
     ) {
-        self.read_inputs(islands, points, bodies);
+        self.read_inputs(islands, manifolds, points);
         if self.inputs == self.last_inputs {
             // A pile at rest: the same manifolds between the same bodies.
             for batch in self.pairs.filled_mut() {
@@ -162,15 +180,25 @@ impl PassPlan {
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
     }
 
-    /// What `plan` reads of each manifold outside the LCP islands, into `inputs`.
+    /// The manifolds outside the LCP islands, each marked if its island is coloured,
+    /// into `inputs`.
     fn read_inputs(
         &mut self,
         islands: &[(usize, usize)],
+        manifolds: &[PlanInput],
         points: &[PointConstraint],
-        bodies: &[SoftBody],
     ) {
         self.inputs.clear();
+        let mut next = 0;
         for &(start, end) in islands {
+            // The islands cover the points in order, so their manifolds follow each other.
+            let from = next;
+            while manifolds
+                .get(next)
+                .is_some_and(|m| (m.first as usize) < end)
+            {
+                next += 1;
+            }
             if points[start].in_lcp {
                 continue;
             }
@@ -179,26 +207,11 @@ impl PassPlan {
             } else {
                 0
             };
-            let mut first = start;
-            while first < end {
-                let p = &points[first];
-                let moves = |i: u32, flag: u32| if bodies[i as usize].moves() { flag } else { 0 };
-                let input = PlanInput {
-                    a: p.a,
-                    b: p.b,
-                    first: first as u32,
-                    flags: coloured
-                        | if p.pair_coupling.is_some() {
-                            PlanInput::TWO_POINTS
-                        } else {
-                            0
-                        }
-                        | moves(p.a, PlanInput::A_MOVES)
-                        | moves(p.b, PlanInput::B_MOVES),
-                };
-                self.inputs.push(input);
-                first += input.count() as usize;
-            }
+            self.inputs
+                .extend(manifolds[from..next].iter().map(|m| PlanInput {
+                    flags: m.flags | coloured,
+                    ..*m
+                }));
         }
     }
 
@@ -1217,6 +1230,24 @@ mod tests {
         }
     }
 
+    /// The plan's inputs as `SoftStepSolver::prepare` notes them: each coupled pair of
+    /// points one manifold, every other point one.
+    fn inputs_of(points: &[PointConstraint], bodies: &[SoftBody]) -> Vec<PlanInput> {
+        let mut inputs = Vec::new();
+        let mut first = 0;
+        while first < points.len() {
+            let p = &points[first];
+            let moves = |i: u32| bodies[i as usize].moves();
+            let mut input = PlanInput::new((p.a, p.b), first, (moves(p.a), moves(p.b)));
+            if p.pair_coupling.is_some() {
+                input.add_second_point();
+            }
+            inputs.push(input);
+            first += input.count() as usize;
+        }
+        inputs
+    }
+
     /// A row of `n` boxes on a fixed floor (body 0), each touching the next: every
     /// manifold coupled, each box on the floor and against its neighbours.
     fn row_on_floor(n: u32) -> (Vec<SoftBody>, Vec<PointConstraint>) {
@@ -1240,7 +1271,12 @@ mod tests {
             points[2 * m].pair_coupling = None;
         }
         let mut plan = PassPlan::default();
-        plan.plan(&[(0, points.len())], &points, &bodies);
+        plan.plan(
+            &[(0, points.len())],
+            &inputs_of(&points, &bodies),
+            &points,
+            &bodies,
+        );
         let mut seen = vec![0; points.len()];
         let mut order = Vec::new();
         for item in &plan.items {
@@ -1293,18 +1329,33 @@ mod tests {
         let kept = plan.items.clone();
         let batched = plan.batches()[0].first_point[3] as usize;
         points[batched].normal_impulse = 0.125;
-        plan.plan(&[(0, points.len())], &points, &bodies);
+        plan.plan(
+            &[(0, points.len())],
+            &inputs_of(&points, &bodies),
+            &points,
+            &bodies,
+        );
         assert_eq!(plan.items, kept);
         assert_eq!(plan.batches()[0].normal_impulses[0].0[3], 0.125);
         points[batched].pair_coupling = None;
-        plan.plan(&[(0, points.len())], &points, &bodies);
+        plan.plan(
+            &[(0, points.len())],
+            &inputs_of(&points, &bodies),
+            &points,
+            &bodies,
+        );
         let mut fresh = PassPlan::default();
-        fresh.plan(&[(0, points.len())], &points, &bodies);
+        fresh.plan(
+            &[(0, points.len())],
+            &inputs_of(&points, &bodies),
+            &points,
+            &bodies,
+        );
         assert_ne!(plan.items, kept);
         assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
         let (bodies, points) = row_on_floor(10);
-        plan.plan(&[(0, 38)], &points, &bodies);
+        plan.plan(&[(0, 38)], &inputs_of(&points, &bodies), &points, &bodies);
         let in_order: Vec<PassItem> = (0..19).map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
     }
