@@ -282,6 +282,9 @@ pub struct SoftStepSolver {
     /// from: each manifold's entry, noted as its points are built.
     plan: PassPlan,
     plan_inputs: Vec<PlanInput>,
+    /// Whether any point has restitution: a pile has none, and skips the pass over its
+    /// points that looks for bounces.
+    may_bounce: bool,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
 }
@@ -376,6 +379,7 @@ impl SoftStepSolver {
         );
         island_ranges(grouped, &mut self.contact_islands);
         self.plan_inputs.clear();
+        self.may_bounce = false;
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -391,6 +395,7 @@ impl SoftStepSolver {
                 if k > 0.0 { 1.0 / k } else { 0.0 }
             };
             let (normal_impulse, tangent_impulse) = self.recalled[i];
+            self.may_bounce |= c.restitution != 0.0;
             self.points.push(PointConstraint {
                 contact: i as u32,
                 a: c.body_a,
@@ -663,6 +668,9 @@ impl SoftStepSolver {
     /// A flat face landing bounces on both corners at once: solved one corner at a time,
     /// the first would tip the body and the second bounce less.
     fn restitution(&mut self, bounce_below: f64) {
+        if !self.may_bounce {
+            return;
+        }
         let bounces = |p: &PointConstraint| {
             p.restitution != 0.0
                 && p.relative_velocity <= -bounce_below
