@@ -367,6 +367,12 @@ impl SoftStepSolver {
             dq: Rot { cos: 1.0, sin: 0.0 },
             dangle: 0.0,
         }));
+        // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
+        // and at rest, and past the bodies `store` writes back.
+        self.bodies.push(SoftBody {
+            dq: Rot { cos: 1.0, sin: 0.0 },
+            ..SoftBody::default()
+        });
         self.points.clear();
         self.memory.recall(contacts, &mut self.recalled);
         // The points are built island by island (each island's in the contacts' order):

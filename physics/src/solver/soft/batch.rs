@@ -23,7 +23,8 @@ use super::avx2::F64x8Avx2;
 #[cfg(target_arch = "x86_64")]
 use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
-use super::{BodyRow, PointConstraint, SoftBody, Softness};
+use super::{BodyRow, NormalBlock, PointConstraint, PointLevers, SoftBody, Softness};
+use crate::math::Vec2;
 use crate::solver::island::counting_sort;
 
 /// Colours of the constraint graph (Box2D v3's count, whose last is its overflow; here a
@@ -174,8 +175,11 @@ impl PassPlan {
                     _ => self.singles.take(first, (points, bodies), items),
                 }
             }
-            self.pairs.end_colour(&mut self.items);
-            self.singles.end_colour(&mut self.items);
+            let pad_from = LanePath::best().fewest_padded();
+            self.pairs
+                .end_colour((points, bodies), &mut self.items, pad_from);
+            self.singles
+                .end_colour((points, bodies), &mut self.items, pad_from);
         }
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
     }
@@ -318,9 +322,17 @@ impl<const N: usize> BatchPool<N> {
     ) {
         self.waiting[self.waiting_len] = first;
         self.waiting_len += 1;
-        if self.waiting_len < LANES {
-            return;
+        if self.waiting_len == LANES {
+            self.push_batch((points, bodies), items);
         }
+    }
+
+    /// The waiting manifolds as the next batch, into `items`.
+    fn push_batch(
+        &mut self,
+        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        items: &mut Vec<PassItem>,
+    ) {
         self.waiting_len = 0;
         if self.filled == self.batches.len() {
             self.batches.push(ManifoldBatch::default());
@@ -335,8 +347,18 @@ impl<const N: usize> BatchPool<N> {
         self.filled += 1;
     }
 
-    /// At the end of a colour, the manifolds short of a batch go into `items` one by one.
-    fn end_colour(&mut self, items: &mut Vec<PassItem>) {
+    /// At the end of a colour, the manifolds short of a batch: a batch with its other
+    /// lanes unused (`PAD`) if they are at least `pad_from`, else one by one into `items`.
+    fn end_colour(
+        &mut self,
+        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        items: &mut Vec<PassItem>,
+        pad_from: usize,
+    ) {
+        if self.waiting_len > 0 && self.waiting_len >= pad_from {
+            self.waiting[self.waiting_len..].fill(PAD);
+            return self.push_batch((points, bodies), items);
+        }
         let alone = self.waiting[..self.waiting_len].iter();
         items.extend(alone.map(|&f| PassItem::Manifold(f, N as u32)));
         self.waiting_len = 0;
@@ -528,7 +550,23 @@ pub(super) enum LanePath {
     Avx512,
 }
 
+/// The first point of an unused lane: the lane is all zeros, its bodies the null body
+/// (the last of the solver's bodies: fixed, at rest, never stored), so that it changes
+/// nothing; `scatter` passes it by.
+pub(super) const PAD: u32 = u32::MAX;
+
 impl LanePath {
+    /// The fewest manifolds worth a batch of their own at the end of a colour, the other
+    /// lanes unused: a batch's pass costs about three manifolds' alone in AVX-512 (one
+    /// register a lane row), six in AVX2 (two).
+    pub(super) fn fewest_padded(self) -> usize {
+        match self {
+            #[cfg(target_arch = "x86_64")]
+            Self::Avx512 => 3,
+            _ => 6,
+        }
+    }
+
     /// The widest path this processor runs (detected once, then a cached flag).
     #[inline(always)]
     pub(super) fn best() -> Self {
@@ -652,12 +690,20 @@ impl<const N: usize> ManifoldBatch<N> {
         unsafe { self.as_lanes_mut::<F64x8Avx512>() }.solve_lanes(bodies, pass)
     }
 
-    /// Fills the batch with the manifolds whose first points are `first_point`.
+    /// Fills the batch with the manifolds whose first points are `first_point` (`PAD`:
+    /// an unused lane, on the null body, the last of `bodies`).
     fn fill(&mut self, first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
         self.first_point = first_point;
         self.may_bounce = false;
+        let unused = first_point
+            .contains(&PAD)
+            .then(|| unused_lane(bodies.len() as u32 - 1));
         for (k, &first) in first_point.iter().enumerate() {
-            let p = &points[first as usize];
+            let lane_points = match &unused {
+                Some(unused) if first == PAD => &unused[..],
+                _ => &points[first as usize..],
+            };
+            let p = &lane_points[0];
             let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
             self.a[k] = p.a;
             self.b[k] = p.b;
@@ -676,7 +722,7 @@ impl<const N: usize> ManifoldBatch<N> {
                 self.inverse[2].0[k] = block.inverse.2;
             }
             let lanes = self.points.iter_mut().zip(&mut self.normal_impulses);
-            for ((lane, impulse), p) in lanes.zip(&points[first as usize..]) {
+            for ((lane, impulse), p) in lanes.zip(lane_points) {
                 impulse.0[k] = p.normal_impulse;
                 lane.normal_lever_a.0[k] = p.levers.normal.0;
                 lane.normal_lever_b.0[k] = p.levers.normal.1;
@@ -687,7 +733,7 @@ impl<const N: usize> ManifoldBatch<N> {
                 lane.tangent_mass.0[k] = p.tangent_mass;
                 lane.tangent_impulse.0[k] = p.tangent_impulse;
             }
-            for (lane, p) in self.bounce.iter_mut().zip(&points[first as usize..]) {
+            for (lane, p) in self.bounce.iter_mut().zip(lane_points) {
                 self.may_bounce |= p.restitution != 0.0;
                 lane.restitution.0[k] = p.restitution;
                 lane.relative_velocity.0[k] = p.relative_velocity;
@@ -704,7 +750,7 @@ impl<const N: usize> ManifoldBatch<N> {
             let tangent = lp.tangent_impulse.0;
             let max_normal = lb.max_normal_impulse.0;
             let relative = lb.relative_velocity.0;
-            for k in 0..LANES {
+            for k in (0..LANES).filter(|&k| self.first_point[k] != PAD) {
                 let p = &mut points[self.first_point[k] as usize + which];
                 p.normal_impulse = normal[k];
                 p.tangent_impulse = tangent[k];
@@ -908,6 +954,36 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             );
         }
     }
+}
+
+/// The points of an unused lane (`PAD`): all zero, between the null body and itself, so
+/// that every pass leaves them and the body as they are.
+fn unused_lane(null_body: u32) -> [PointConstraint; 2] {
+    let point = PointConstraint {
+        contact: PAD,
+        a: null_body,
+        b: null_body,
+        normal: Vec2::zeros(),
+        levers: PointLevers::default(),
+        base_separation: 0.0,
+        normal_mass: 0.0,
+        tangent_mass: 0.0,
+        friction: 0.0,
+        restitution: 0.0,
+        relative_velocity: 0.0,
+        normal_impulse: 0.0,
+        tangent_impulse: 0.0,
+        max_normal_impulse: 0.0,
+        closing_acceleration: 0.0,
+        in_lcp: false,
+        pair_coupling: Some(NormalBlock {
+            k11: 0.0,
+            k12: 0.0,
+            k22: 0.0,
+            inverse: (0.0, 0.0, 0.0),
+        }),
+    };
+    [point; 2]
 }
 
 /// A point's normal target, mass scale and impulse scale (see `normal_target`), lane by
@@ -1260,7 +1336,37 @@ mod tests {
         for (a, b) in pairs {
             points.extend(manifold(&mut numbers, &bodies, (a, b), Vec2::new(0.0, 1.0)));
         }
+        bodies.push(null_body());
         (bodies, points)
+    }
+
+    /// The solver's last body, where unused lanes point.
+    fn null_body() -> SoftBody {
+        SoftBody {
+            dq: Rot::new(0.0),
+            ..SoftBody::default()
+        }
+    }
+
+    #[test]
+    fn a_batch_with_unused_lanes_solves_its_manifolds_and_leaves_the_null_body() {
+        for seed in 1..=100u64 {
+            let (mut bodies, points) = eight_manifolds_both_ways(seed);
+            bodies.push(null_body());
+            // Three manifolds of the eight, then five unused lanes.
+            let firsts = [0, 2, 4, PAD, PAD, PAD, PAD, PAD];
+            for use_bias in [true, false] {
+                let pass = pass(use_bias);
+                let (mut one_by_one, mut their_points) = (bodies.clone(), points.clone());
+                for f in [0usize, 2, 4] {
+                    let (first, second) = their_points.split_at_mut(f + 1);
+                    solve_pair(&mut one_by_one, (&mut first[f], &mut second[0]), &pass);
+                }
+                let expected = state(&one_by_one, &their_points);
+                let label = format!("seed {seed}, bias {use_bias}");
+                assert_batch_gives::<2>((&bodies, &points), firsts, &pass, &expected, &label);
+            }
+        }
     }
 
     #[test]
@@ -1281,7 +1387,8 @@ mod tests {
         let mut order = Vec::new();
         for item in &plan.items {
             let lanes_share_no_moving_body = |a: &[u32; LANES], b: &[u32; LANES]| {
-                let mut moving: Vec<u32> = a.iter().chain(b).copied().filter(|&i| i != 0).collect();
+                let moves = |i: &u32| bodies[*i as usize].moves();
+                let mut moving: Vec<u32> = a.iter().chain(b).copied().filter(moves).collect();
                 let len = moving.len();
                 moving.sort_unstable();
                 moving.dedup();
@@ -1300,7 +1407,7 @@ mod tests {
                 }
                 PassItem::Manifold(first, _) => vec![first],
             };
-            for f in firsts {
+            for f in firsts.into_iter().filter(|&f| f != PAD) {
                 seen[f as usize] += 1;
                 order.push(f);
             }
