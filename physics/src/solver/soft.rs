@@ -386,6 +386,10 @@ impl SoftStepSolver {
         island_ranges(grouped, &mut self.contact_islands);
         self.plan_inputs.clear();
         self.may_bounce = false;
+        // Each manifold goes into the kept plan's lanes as soon as it is complete (its
+        // points still in the cache), and `plan` below fills only a changed plan.
+        self.plan.begin_filling();
+        let mut open_manifold = None;
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -439,6 +443,9 @@ impl SoftStepSolver {
                     .last_mut()
                     .expect("the first point's entry")
                     .add_second_point();
+                self.plan
+                    .fill_manifold(k - 1, 2, &self.points, &self.bodies);
+                open_manifold = None;
             } else {
                 let moves = |b: &SolverBody| b.inv_mass > 0.0 || b.inv_inertia > 0.0;
                 self.plan_inputs.push(PlanInput::new(
@@ -446,7 +453,16 @@ impl SoftStepSolver {
                     k,
                     (moves(a), moves(b)),
                 ));
+                // The point before, if it began a manifold, was that manifold's only one.
+                if let Some(single) = open_manifold.replace(k) {
+                    self.plan
+                        .fill_manifold(single, 1, &self.points, &self.bodies);
+                }
             }
+        }
+        if let Some(single) = open_manifold {
+            self.plan
+                .fill_manifold(single, 1, &self.points, &self.bodies);
         }
         self.contact_lcp
             .prepare(&self.bodies, &mut self.points, &self.contact_islands);

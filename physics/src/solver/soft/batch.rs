@@ -69,7 +69,38 @@ pub(super) struct PassPlan {
     /// is unchanged, so is the plan, and only the batches' numbers are read again.
     inputs: Vec<PlanInput>,
     last_inputs: Vec<PlanInput>,
+    /// Where the plan put each manifold, by its first point (`Slot`; `NO_SLOT` for the
+    /// manifolds solved alone): while the plan is kept, a manifold's lanes are written
+    /// as its points are built (`fill_manifold`), with the points still in the cache.
+    slot_of: Vec<u32>,
+    /// Whether this step's manifolds were written into the kept plan's lanes as they
+    /// were built (`begin_filling`), so that `plan` need not fill the batches again.
+    filled_while_built: bool,
 }
+
+/// No batch lane: the manifold is solved alone, or in an LCP island.
+const NO_SLOT: u32 = u32::MAX;
+
+/// A manifold's place in the plan: its pool (two-point or one-point batches), batch and
+/// lane, packed in a `u32` as `pool << 31 | batch << 3 | lane`.
+struct Slot;
+
+impl Slot {
+    fn pack(two_points: bool, batch: usize, lane: usize) -> u32 {
+        (u32::from(two_points) << 31) | ((batch as u32) << 3) | lane as u32
+    }
+
+    /// (two-point pool, batch, lane).
+    fn unpack(slot: u32) -> (bool, usize, usize) {
+        (
+            slot >> 31 == 1,
+            ((slot & !(1 << 31)) >> 3) as usize,
+            (slot & 7) as usize,
+        )
+    }
+}
+
+const _: () = assert!(LANES == 8, "`Slot` packs the lane in three bits");
 
 /// What planning reads of one manifold: its bodies, first point, and `PlanInput::flags`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -123,13 +154,16 @@ impl PassPlan {
         bodies: &[SoftBody],
     ) {
         self.read_inputs(islands, manifolds, points);
+        let filled_while_built = std::mem::take(&mut self.filled_while_built);
         if self.inputs == self.last_inputs {
             // A pile at rest: the same manifolds between the same bodies.
-            for batch in self.pairs.filled_mut() {
-                batch.fill(batch.first_point, points, bodies);
-            }
-            for batch in self.singles.filled_mut() {
-                batch.fill(batch.first_point, points, bodies);
+            if !filled_while_built {
+                for batch in self.pairs.filled_mut() {
+                    batch.fill(batch.first_point, points, bodies);
+                }
+                for batch in self.singles.filled_mut() {
+                    batch.fill(batch.first_point, points, bodies);
+                }
             }
             return;
         }
@@ -182,6 +216,59 @@ impl PassPlan {
                 .end_colour((points, bodies), &mut self.items, pad_from);
         }
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
+        self.slot_of.clear();
+        self.slot_of.resize(points.len(), NO_SLOT);
+        let pairs = self.pairs.filled().iter().map(|b| (true, &b.first_point));
+        let singles = self
+            .singles
+            .filled()
+            .iter()
+            .map(|b| (false, &b.first_point));
+        let mut batch_index = [0, 0];
+        for (two_points, firsts) in pairs.chain(singles) {
+            let batch = &mut batch_index[usize::from(two_points)];
+            for (lane, &first) in firsts.iter().enumerate().filter(|f| *f.1 != PAD) {
+                self.slot_of[first as usize] = Slot::pack(two_points, *batch, lane);
+            }
+            *batch += 1;
+        }
+    }
+
+    /// Starts a step whose manifolds are then written into the kept plan's lanes as they
+    /// are built (`fill_manifold`). If the plan turns out to change, `plan` makes and
+    /// fills the new one as usual.
+    pub fn begin_filling(&mut self) {
+        self.filled_while_built = true;
+        for batch in self.pairs.filled_mut() {
+            batch.may_bounce = false;
+        }
+        for batch in self.singles.filled_mut() {
+            batch.may_bounce = false;
+        }
+    }
+
+    /// The manifold of `count` points starting at `first`, just built, into the lane the
+    /// kept plan has for it, if any and of its size.
+    #[inline]
+    pub fn fill_manifold(
+        &mut self,
+        first: usize,
+        count: usize,
+        points: &[PointConstraint],
+        bodies: &[SoftBody],
+    ) {
+        let Some(&slot) = self.slot_of.get(first).filter(|&&s| s != NO_SLOT) else {
+            return;
+        };
+        let (two_points, batch, lane) = Slot::unpack(slot);
+        let manifold = &points[first..first + count];
+        match (two_points, count) {
+            (true, 2) => self.pairs.batches[batch].fill_lane(lane, first as u32, manifold, bodies),
+            (false, 1) => {
+                self.singles.batches[batch].fill_lane(lane, first as u32, manifold, bodies)
+            }
+            _ => {} // the plan changes this step
+        }
     }
 
     /// The manifolds outside the LCP islands, each marked if its island is coloured,
@@ -703,43 +790,56 @@ impl<const N: usize> ManifoldBatch<N> {
                 Some(unused) if first == PAD => &unused[..],
                 _ => &points[first as usize..],
             };
-            let p = &lane_points[0];
-            let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
-            self.a[k] = p.a;
-            self.b[k] = p.b;
-            self.inv_inertia_a.0[k] = a.inv_inertia;
-            self.inv_inertia_b.0[k] = b.inv_inertia;
-            self.normal_x.0[k] = p.normal.x;
-            self.normal_y.0[k] = p.normal.y;
-            self.friction.0[k] = p.friction;
-            if N == 2 {
-                let block = p.pair_coupling.expect("batched pairs are coupled");
-                self.k11.0[k] = block.k11;
-                self.k12.0[k] = block.k12;
-                self.k22.0[k] = block.k22;
-                self.inverse[0].0[k] = block.inverse.0;
-                self.inverse[1].0[k] = block.inverse.1;
-                self.inverse[2].0[k] = block.inverse.2;
-            }
-            let lanes = self.points.iter_mut().zip(&mut self.normal_impulses);
-            for ((lane, impulse), p) in lanes.zip(lane_points) {
-                impulse.0[k] = p.normal_impulse;
-                lane.normal_lever_a.0[k] = p.levers.normal.0;
-                lane.normal_lever_b.0[k] = p.levers.normal.1;
-                lane.reach_a.0[k] = p.levers.reach.0;
-                lane.reach_b.0[k] = p.levers.reach.1;
-                lane.base_separation.0[k] = p.base_separation;
-                lane.normal_mass.0[k] = p.normal_mass;
-                lane.tangent_mass.0[k] = p.tangent_mass;
-                lane.tangent_impulse.0[k] = p.tangent_impulse;
-            }
-            for (lane, p) in self.bounce.iter_mut().zip(lane_points) {
-                self.may_bounce |= p.restitution != 0.0;
-                lane.restitution.0[k] = p.restitution;
-                lane.relative_velocity.0[k] = p.relative_velocity;
-                lane.max_normal_impulse.0[k] = p.max_normal_impulse;
-                lane.closing_acceleration.0[k] = p.closing_acceleration;
-            }
+            self.fill_lane(k, first, lane_points, bodies);
+        }
+    }
+
+    /// Lane `k`: the manifold whose points begin `lane_points` (its first point `first`).
+    #[inline(always)]
+    fn fill_lane(
+        &mut self,
+        k: usize,
+        first: u32,
+        lane_points: &[PointConstraint],
+        bodies: &[SoftBody],
+    ) {
+        self.first_point[k] = first;
+        let p = &lane_points[0];
+        let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
+        self.a[k] = p.a;
+        self.b[k] = p.b;
+        self.inv_inertia_a.0[k] = a.inv_inertia;
+        self.inv_inertia_b.0[k] = b.inv_inertia;
+        self.normal_x.0[k] = p.normal.x;
+        self.normal_y.0[k] = p.normal.y;
+        self.friction.0[k] = p.friction;
+        if N == 2 {
+            let block = p.pair_coupling.expect("batched pairs are coupled");
+            self.k11.0[k] = block.k11;
+            self.k12.0[k] = block.k12;
+            self.k22.0[k] = block.k22;
+            self.inverse[0].0[k] = block.inverse.0;
+            self.inverse[1].0[k] = block.inverse.1;
+            self.inverse[2].0[k] = block.inverse.2;
+        }
+        let lanes = self.points.iter_mut().zip(&mut self.normal_impulses);
+        for ((lane, impulse), p) in lanes.zip(lane_points) {
+            impulse.0[k] = p.normal_impulse;
+            lane.normal_lever_a.0[k] = p.levers.normal.0;
+            lane.normal_lever_b.0[k] = p.levers.normal.1;
+            lane.reach_a.0[k] = p.levers.reach.0;
+            lane.reach_b.0[k] = p.levers.reach.1;
+            lane.base_separation.0[k] = p.base_separation;
+            lane.normal_mass.0[k] = p.normal_mass;
+            lane.tangent_mass.0[k] = p.tangent_mass;
+            lane.tangent_impulse.0[k] = p.tangent_impulse;
+        }
+        for (lane, p) in self.bounce.iter_mut().zip(lane_points) {
+            self.may_bounce |= p.restitution != 0.0;
+            lane.restitution.0[k] = p.restitution;
+            lane.relative_velocity.0[k] = p.relative_velocity;
+            lane.max_normal_impulse.0[k] = p.max_normal_impulse;
+            lane.closing_acceleration.0[k] = p.closing_acceleration;
         }
     }
 
@@ -1444,6 +1544,34 @@ mod tests {
         );
         assert_eq!(plan.items, kept);
         assert_eq!(plan.batches()[0].normal_impulses[0].0[3], 0.125);
+        // The same, with the manifolds written into their lanes as they are built (as
+        // `SoftStepSolver::prepare` does): every batch as a fresh fill leaves it.
+        for p in &mut points {
+            p.tangent_impulse += 0.5;
+        }
+        plan.begin_filling();
+        for input in inputs_of(&points, &bodies) {
+            let (first, count) = (input.first as usize, input.count() as usize);
+            plan.fill_manifold(first, count, &points, &bodies);
+        }
+        plan.plan(
+            &[(0, points.len())],
+            &inputs_of(&points, &bodies),
+            &points,
+            &bodies,
+        );
+        assert_eq!(plan.items, kept);
+        for batch in plan.batches() {
+            let mut fresh = *batch;
+            fresh.fill(batch.first_point, &points, &bodies);
+            let bits = |b: &ManifoldBatch<2>| {
+                let lanes = b.points.iter().flat_map(|p| p.tangent_impulse.0);
+                let impulses = b.normal_impulses.iter().flat_map(|l| l.0);
+                lanes.chain(impulses).map(f64::to_bits).collect::<Vec<_>>()
+            };
+            assert_eq!(bits(batch), bits(&fresh));
+            assert_eq!(batch.may_bounce, fresh.may_bounce);
+        }
         points[batched].pair_coupling = None;
         plan.plan(
             &[(0, points.len())],
