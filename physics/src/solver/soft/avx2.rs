@@ -37,7 +37,8 @@ const _: () = {
 // SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions this
 // type is used in are compiled for and only called with (`ManifoldBatch::as_avx2`); the
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
-// inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`.
+// inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`, and
+// the bodies lie inside the slice (`Lanes::gather`'s precondition).
 
 /// Row `k` of four becomes lane `k` of each column (and back: it is its own inverse).
 #[inline(always)]
@@ -56,17 +57,18 @@ fn transpose([r0, r1, r2, r3]: [__m256d; 4]) -> [__m256d; 4] {
     }
 }
 
-/// Where the 32-byte row `row` of the body `index` names starts (bounds-checked).
+/// Where the 32-byte row `row` of the body `index` names starts. Not bounds-checked:
+/// `gather`'s caller guarantees `index < bodies.len()` (`Lanes::gather`).
 #[inline(always)]
 fn row(bodies: &[SoftBody], index: u32, row: BodyRow) -> *const f64 {
-    let body: *const SoftBody = &bodies[index as usize];
+    let body: *const SoftBody = bodies.as_ptr().wrapping_add(index as usize);
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
 /// `row`, to write through: made from the mutable borrow, not a shared one.
 #[inline(always)]
 fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
-    let body: *mut SoftBody = &mut bodies[index as usize];
+    let body: *mut SoftBody = bodies.as_mut_ptr().wrapping_add(index as usize);
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
@@ -149,7 +151,7 @@ impl Lanes for F64x8Avx2 {
     }
 
     #[inline(always)]
-    fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
+    unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
         // Written out: `array::map` was left out of line here.
         let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[k], which)) };
         let [a0, a1, a2, a3] = transpose([load(0), load(1), load(2), load(3)]);
@@ -158,7 +160,11 @@ impl Lanes for F64x8Avx2 {
     }
 
     #[inline(always)]
-    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]) {
+    unsafe fn scatter_velocities(
+        columns: [Self; 4],
+        bodies: &mut [SoftBody],
+        index: &[u32; LANES],
+    ) {
         let [c0, c1, c2, c3] = columns;
         let low = transpose([c0.0, c1.0, c2.0, c3.0]);
         let high = transpose([c0.1, c1.1, c2.1, c3.1]);

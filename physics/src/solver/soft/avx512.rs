@@ -31,19 +31,20 @@ const _: () = {
 // this type is used in are compiled for and only called with (`ManifoldBatch::as_lanes`);
 // the aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name,
 // which lie inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned
-// `SoftBody`.
+// `SoftBody`, and the bodies lie inside the slice (`Lanes::gather`'s precondition).
 
-/// Where the 32-byte row `row` of the body `index` names starts (bounds-checked).
+/// Where the 32-byte row `row` of the body `index` names starts. Not bounds-checked:
+/// `gather`'s caller guarantees `index < bodies.len()` (`Lanes::gather`).
 #[inline(always)]
 fn row(bodies: &[SoftBody], index: u32, row: BodyRow) -> *const f64 {
-    let body: *const SoftBody = &bodies[index as usize];
+    let body: *const SoftBody = bodies.as_ptr().wrapping_add(index as usize);
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
 /// `row`, to write through: made from the mutable borrow, not a shared one.
 #[inline(always)]
 fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
-    let body: *mut SoftBody = &mut bodies[index as usize];
+    let body: *mut SoftBody = bodies.as_mut_ptr().wrapping_add(index as usize);
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
@@ -118,7 +119,7 @@ impl Lanes for F64x8Avx512 {
     /// (one half each), `unpck` pairs rows within each 128-bit quarter, and `vpermt2pd`
     /// puts the pairs in lane order.
     #[inline(always)]
-    fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
+    unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
         let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[k], which)) };
         let joined = |k: usize| unsafe {
             _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(load(k)), load(k + 4))
@@ -140,7 +141,11 @@ impl Lanes for F64x8Avx512 {
 
     /// `gather`'s inverse, the rows stored lane 0 first.
     #[inline(always)]
-    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]) {
+    unsafe fn scatter_velocities(
+        columns: [Self; 4],
+        bodies: &mut [SoftBody],
+        index: &[u32; LANES],
+    ) {
         let [c0, c1, c2, c3] = columns.map(|c| c.0);
         // u0's quarters are the first halves of rows 0, 2, 4, 6; u1's of rows 1, 3, 5, 7;
         // u2 and u3 hold the second halves.

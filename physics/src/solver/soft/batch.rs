@@ -558,15 +558,22 @@ struct LaneVelocity<L> {
 }
 
 impl<L: Lanes> LaneVelocity<L> {
+    /// # Safety
+    /// Every index must be below `bodies.len()` (`Lanes::gather`).
     #[inline(always)]
-    fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
-        let [x, y, w, inv_mass] = L::gather(bodies, index, BodyRow::Velocity);
+    unsafe fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
+        // SAFETY: the caller's precondition.
+        let [x, y, w, inv_mass] = unsafe { L::gather(bodies, index, BodyRow::Velocity) };
         Self { x, y, w, inv_mass }
     }
 
+    /// # Safety
+    /// As `load`.
     #[inline(always)]
-    fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
-        L::scatter_velocities([self.x, self.y, self.w, self.inv_mass], bodies, index);
+    unsafe fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
+        let columns = [self.x, self.y, self.w, self.inv_mass];
+        // SAFETY: the caller's precondition.
+        unsafe { L::scatter_velocities(columns, bodies, index) };
     }
 }
 
@@ -864,26 +871,50 @@ impl<const N: usize> ManifoldBatch<N> {
 }
 
 impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
+    /// Whether every lane's bodies are in `bodies`: checked once a pass, so that the
+    /// gathers need not check each index.
     #[inline(always)]
-    fn load(&self, bodies: &[SoftBody]) -> LanePair<L> {
-        LanePair {
-            a: LaneVelocity::load(bodies, &self.a),
-            b: LaneVelocity::load(bodies, &self.b),
-            inv_inertia: (self.inv_inertia_a, self.inv_inertia_b),
+    fn indices_fit(&self, bodies: &[SoftBody]) -> bool {
+        let highest = self.a.iter().chain(&self.b).fold(0, |m, &i| m.max(i));
+        (highest as usize) < bodies.len()
+    }
+
+    /// # Safety
+    /// `indices_fit(bodies)`.
+    #[inline(always)]
+    unsafe fn load(&self, bodies: &[SoftBody]) -> LanePair<L> {
+        // SAFETY: the caller's precondition.
+        unsafe {
+            LanePair {
+                a: LaneVelocity::load(bodies, &self.a),
+                b: LaneVelocity::load(bodies, &self.b),
+                inv_inertia: (self.inv_inertia_a, self.inv_inertia_b),
+            }
         }
     }
 
     /// A's lanes, then B's, as `BodyPair::store` writes them.
+    ///
+    /// # Safety
+    /// `indices_fit(bodies)`.
     #[inline(always)]
-    fn store(&self, pair: &LanePair<L>, bodies: &mut [SoftBody]) {
-        pair.a.store(bodies, &self.a);
-        pair.b.store(bodies, &self.b);
+    unsafe fn store(&self, pair: &LanePair<L>, bodies: &mut [SoftBody]) {
+        // SAFETY: the caller's precondition.
+        unsafe {
+            pair.a.store(bodies, &self.a);
+            pair.b.store(bodies, &self.b);
+        }
     }
 
     /// `warm_start` for the batch's points.
     #[inline(always)]
     fn warm_start_lanes(&self, bodies: &mut [SoftBody]) {
-        let mut pair = self.load(bodies);
+        assert!(
+            self.indices_fit(bodies),
+            "a batch's bodies are the solver's"
+        );
+        // SAFETY: just checked.
+        let mut pair = unsafe { self.load(bodies) };
         let normal = (self.normal_x, self.normal_y);
         let tangent = (-self.normal_y, self.normal_x);
         for (p, &impulse) in self.points.iter().zip(&self.normal_impulses) {
@@ -891,14 +922,19 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             // The tangent row's levers are the reaches (`PointLevers::tangent`).
             pair.apply_along(tangent, p.reach_a, p.reach_b, p.tangent_impulse);
         }
-        self.store(&pair, bodies);
+        // SAFETY: checked above.
+        unsafe { self.store(&pair, bodies) };
     }
 
     /// `separation` for each lane's point `which`.
+    ///
+    /// # Safety
+    /// `indices_fit(bodies)`.
     #[inline(always)]
-    fn separations(&self, bodies: &[SoftBody]) -> [L; N] {
-        let [dpx_a, dpy_a, cos_a, sin_a] = L::gather(bodies, &self.a, BodyRow::Motion);
-        let [dpx_b, dpy_b, cos_b, sin_b] = L::gather(bodies, &self.b, BodyRow::Motion);
+    unsafe fn separations(&self, bodies: &[SoftBody]) -> [L; N] {
+        // SAFETY (both): the caller's precondition.
+        let [dpx_a, dpy_a, cos_a, sin_a] = unsafe { L::gather(bodies, &self.a, BodyRow::Motion) };
+        let [dpx_b, dpy_b, cos_b, sin_b] = unsafe { L::gather(bodies, &self.b, BodyRow::Motion) };
         let (dx, dy) = (dpx_a - dpx_b, dpy_a - dpy_b);
         let one = L::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
@@ -918,8 +954,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// `solve_pair` on every lane.
     #[inline(always)]
     fn solve_lanes(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        let separations = self.separations(bodies);
-        let mut pair = self.load(bodies);
+        assert!(
+            self.indices_fit(bodies),
+            "a batch's bodies are the solver's"
+        );
+        // SAFETY: just checked.
+        let (separations, mut pair) = unsafe { (self.separations(bodies), self.load(bodies)) };
         let normal = (self.normal_x, self.normal_y);
         let zero = L::splat(0.0);
         let one = L::splat(1.0);
@@ -963,7 +1003,8 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             p.tangent_impulse = total;
             pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
         }
-        self.store(&pair, bodies);
+        // SAFETY: checked above.
+        unsafe { self.store(&pair, bodies) };
     }
 
     /// A two-point manifold's normals, as `solve_pair` solves them: together, except in

@@ -39,12 +39,19 @@ pub(super) trait Lanes:
     fn ne(self, rhs: Self) -> Self::Mask;
     /// The row `row` of the bodies `index` names, one body a lane: its four numbers as
     /// four columns (`SoftBody::row`).
-    fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4];
+    ///
+    /// # Safety
+    /// Every index must be below `bodies.len()` (the SIMD paths do not check them: the
+    /// batch checks all its indices once per pass, `ManifoldBatch::indices_fit`).
+    unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4];
     /// Writes the velocity row's first three columns back, lane 0 first, so that a fixed
     /// body in several lanes of one side keeps the last lane's, as the scalar lane-by-lane
     /// stores left it (it can differ only in the sign of a zero); the fourth column must
     /// be the inverse masses `gather` read.
-    fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]);
+    ///
+    /// # Safety
+    /// As `gather`.
+    unsafe fn scatter_velocities(columns: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]);
 }
 
 /// A lane-wise condition of `L`'s lanes.
@@ -137,13 +144,17 @@ impl Lanes for F64x8 {
     }
 
     #[inline(always)]
-    fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4] {
+    unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], row: BodyRow) -> [Self; 4] {
         let rows = index.map(|i| bodies[i as usize].row(row));
         std::array::from_fn(|c| Self::from_fn(|k| rows[k][c]))
     }
 
     #[inline(always)]
-    fn scatter_velocities([x, y, w, _]: [Self; 4], bodies: &mut [SoftBody], index: &[u32; LANES]) {
+    unsafe fn scatter_velocities(
+        [x, y, w, _]: [Self; 4],
+        bodies: &mut [SoftBody],
+        index: &[u32; LANES],
+    ) {
         for k in 0..LANES {
             let body = &mut bodies[index[k] as usize];
             body.v.x = x.0[k];
