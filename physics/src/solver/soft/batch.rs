@@ -9,8 +9,8 @@
 //! coupled two-point manifolds at a time are one `ManifoldBatch<2>`, and eight one-point
 //! ones a `ManifoldBatch<1>`, solved with the same arithmetic as `solve_pair` and
 //! `solve_point`, lane by lane, so a batch gives the same bits as its eight manifolds
-//! solved one after another, whichever lanes the processor has. Small islands keep the points' order, one
-//! manifold at a time.
+//! solved one after another, whichever lanes the processor has. Small islands keep the
+//! points' order, one manifold at a time.
 //!
 //! Against the points' order (by body pair: a pile's bottom row first), colours stand the
 //! 20- and 40-row pyramids stiller (top drift 0.0023 and 0.0018 of a box after 500 steps,
