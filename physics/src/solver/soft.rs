@@ -344,8 +344,11 @@ impl SoftStepSolver {
                 j.motor_step_total += j.motor_impulse;
             }
         }
-        self.plan.scatter(&mut self.points);
-        self.restitution(bounce_below);
+        if self.may_bounce {
+            // Restitution works on the points: they take the batches' impulses first.
+            self.plan.scatter(&mut self.points);
+            self.restitution(bounce_below);
+        }
         self.store(bodies, contacts, joints);
         self.report();
     }
@@ -742,10 +745,30 @@ impl SoftStepSolver {
             b.position += s.dp;
             b.angle += s.dangle;
         }
-        for p in &self.points {
-            let c = &mut contacts[p.contact as usize];
-            c.normal_impulse = p.normal_impulse;
-            c.tangent_impulse = p.tangent_impulse;
+        let store_points = |points: &[PointConstraint], contacts: &mut [Contact]| {
+            for p in points {
+                let c = &mut contacts[p.contact as usize];
+                c.normal_impulse = p.normal_impulse;
+                c.tangent_impulse = p.tangent_impulse;
+            }
+        };
+        if self.may_bounce {
+            store_points(&self.points, contacts);
+        } else {
+            // The batched points' impulses are still in their lanes: from there, and
+            // the rest (LCP islands, manifolds solved alone) from the points.
+            self.plan.store_impulses(contacts);
+            for &(start, end, lcp) in &self.contact_lcp.all_islands {
+                if lcp {
+                    store_points(&self.points[start..end], contacts);
+                }
+            }
+            for item in &self.plan.items {
+                if let PassItem::Manifold(first, count) = *item {
+                    let (first, count) = (first as usize, count as usize);
+                    store_points(&self.points[first..first + count], contacts);
+                }
+            }
         }
         self.memory.store(contacts);
         self.joint_memory.clear();

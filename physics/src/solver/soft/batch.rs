@@ -25,6 +25,7 @@ use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, NormalBlock, PointConstraint, PointLevers, SoftBody, Softness};
 use crate::math::Vec2;
+use crate::solver::contact::Contact;
 use crate::solver::island::counting_sort;
 
 /// Colours of the constraint graph (Box2D v3's count, whose last is its overflow; here a
@@ -316,6 +317,16 @@ impl PassPlan {
         }
     }
 
+    /// The batches' accumulated impulses, into their contacts.
+    pub fn store_impulses(&self, contacts: &mut [Contact]) {
+        for batch in self.batches() {
+            batch.store_impulses(contacts);
+        }
+        for batch in self.point_batches() {
+            batch.store_impulses(contacts);
+        }
+    }
+
     /// The step's batches of two-point manifolds.
     pub fn batches(&self) -> &[ManifoldBatch<2>] {
         self.pairs.filled()
@@ -503,6 +514,9 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     /// The inverse of the 2 × 2 block, `[i11, i12, i22]` (two-point manifolds only).
     inverse: [L; 3],
     points: [LanePoints<L>; N],
+    /// Each lane's points' contacts (`PAD` in unused lanes), where a step with nothing
+    /// that bounces writes their impulses straight from the lanes (`store_impulses`).
+    contacts: [[u32; LANES]; N],
     /// Each point's accumulated normal impulse, apart from `points` so that a lane
     /// solved both ways (`solve_normals_together`) copies only these.
     normal_impulses: [L; N],
@@ -540,6 +554,7 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             inverse: [zero; 3],
             may_bounce: false,
             points: [LanePoints::default(); N],
+            contacts: [[PAD; LANES]; N],
             normal_impulses: [zero; N],
             bounce: [LaneBounce::default(); N],
         }
@@ -830,7 +845,8 @@ impl<const N: usize> ManifoldBatch<N> {
             self.inverse[2].0[k] = block.inverse.2;
         }
         let lanes = self.points.iter_mut().zip(&mut self.normal_impulses);
-        for ((lane, impulse), p) in lanes.zip(lane_points) {
+        for (((lane, impulse), contacts), p) in lanes.zip(&mut self.contacts).zip(lane_points) {
+            contacts[k] = p.contact;
             impulse.0[k] = p.normal_impulse;
             lane.normal_lever_a.0[k] = p.levers.normal.0;
             lane.normal_lever_b.0[k] = p.levers.normal.1;
@@ -847,6 +863,18 @@ impl<const N: usize> ManifoldBatch<N> {
             lane.relative_velocity.0[k] = p.relative_velocity;
             lane.max_normal_impulse.0[k] = p.max_normal_impulse;
             lane.closing_acceleration.0[k] = p.closing_acceleration;
+        }
+    }
+
+    /// The accumulated impulses, into the lanes' contacts.
+    pub(super) fn store_impulses(&self, contacts: &mut [Contact]) {
+        let points = self.points.iter().zip(&self.normal_impulses);
+        for ((lanes, normal), indices) in points.zip(&self.contacts) {
+            for (k, &index) in indices.iter().enumerate().filter(|&(_, &i)| i != PAD) {
+                let c = &mut contacts[index as usize];
+                c.normal_impulse = normal.0[k];
+                c.tangent_impulse = lanes.tangent_impulse.0[k];
+            }
         }
     }
 
