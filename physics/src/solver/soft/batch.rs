@@ -1518,6 +1518,48 @@ mod tests {
     }
 
     #[test]
+    fn a_batch_writes_the_impulses_into_its_contacts_as_its_points_would() {
+        let (mut bodies, mut points) = eight_manifolds(3);
+        bodies.push(null_body());
+        // Contacts numbered against the points' order, so that a mix-up shows.
+        for (k, p) in points.iter_mut().enumerate() {
+            p.contact = 15 - k as u32;
+        }
+        let firsts = [0, 2, 4, 6, 8, PAD, PAD, PAD];
+        let mut batch = ManifoldBatch::<2>::default();
+        batch.fill(firsts, &points, &bodies);
+        batch.solve(&mut bodies, &pass(true));
+        let contact = Contact {
+            body_a: 0,
+            body_b: 0,
+            point: Vec2::zeros(),
+            normal: Vec2::zeros(),
+            depth: 0.0,
+            id: crate::collide::FeatureId(0),
+            restitution: 0.0,
+            friction: 0.0,
+            approach_velocity: 0.0,
+            normal_velocity: 0.0,
+            normal_impulse: -1.0,
+            tangent_impulse: -1.0,
+        };
+        let (mut from_lanes, mut from_points) = (vec![contact; 16], vec![contact; 16]);
+        batch.store_impulses(&mut from_lanes);
+        batch.scatter(&mut points);
+        for p in &points[..10] {
+            let c = &mut from_points[p.contact as usize];
+            (c.normal_impulse, c.tangent_impulse) = (p.normal_impulse, p.tangent_impulse);
+        }
+        assert_eq!(from_lanes, from_points);
+        // The unused lanes' points (10 to 15) are left alone.
+        assert!(
+            points[10..]
+                .iter()
+                .all(|p| from_lanes[p.contact as usize].normal_impulse == -1.0)
+        );
+    }
+
+    #[test]
     fn a_batch_with_unused_lanes_solves_its_manifolds_and_leaves_the_null_body() {
         for seed in 1..=100u64 {
             let (mut bodies, points) = eight_manifolds_both_ways(seed);
