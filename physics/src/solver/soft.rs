@@ -15,7 +15,7 @@ use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
-use batch::{PassItem, PassPlan, PassSettings, PlanInput};
+use batch::{LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -146,6 +146,14 @@ impl SoftBody {
         match row {
             BodyRow::Velocity => 0,
             BodyRow::Motion => 4,
+        }
+    }
+
+    /// The body a batch's unused lanes point at: fixed and at rest.
+    fn null() -> Self {
+        Self {
+            dq: Rot { cos: 1.0, sin: 0.0 },
+            ..Self::default()
         }
     }
 
@@ -372,10 +380,7 @@ impl SoftStepSolver {
         }));
         // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
         // and at rest, and past the bodies `store` writes back.
-        self.bodies.push(SoftBody {
-            dq: Rot { cos: 1.0, sin: 0.0 },
-            ..SoftBody::default()
-        });
+        self.bodies.push(SoftBody::null());
         self.points.clear();
         self.memory.recall(contacts, &mut self.recalled);
         // The points are built island by island (each island's in the contacts' order):
@@ -384,7 +389,7 @@ impl SoftStepSolver {
             contacts.len(),
             bodies.len(),
             |i| (contacts[i].body_a, contacts[i].body_b),
-            |i| bodies[i as usize].inv_mass > 0.0 || bodies[i as usize].inv_inertia > 0.0,
+            |i| self.bodies[i as usize].moves(),
         );
         island_ranges(grouped, &mut self.contact_islands);
         self.plan_inputs.clear();
@@ -450,11 +455,11 @@ impl SoftStepSolver {
                     .fill_manifold(k - 1, 2, &self.points, &self.bodies);
                 open_manifold = None;
             } else {
-                let moves = |b: &SolverBody| b.inv_mass > 0.0 || b.inv_inertia > 0.0;
+                let moves = |i: u32| self.bodies[i as usize].moves();
                 self.plan_inputs.push(PlanInput::new(
                     (c.body_a, c.body_b),
                     k,
-                    (moves(a), moves(b)),
+                    (moves(c.body_a), moves(c.body_b)),
                 ));
                 // The point before, if it began a manifold, was that manifold's only one.
                 if let Some(single) = open_manifold.replace(k) {
@@ -608,10 +613,13 @@ impl SoftStepSolver {
             }
         }
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
+        let lanes = LanePath::best();
         for item in &self.plan.items {
             match *item {
-                PassItem::Batch(k) => batches[k as usize].warm_start(&mut self.bodies),
-                PassItem::PointBatch(k) => point_batches[k as usize].warm_start(&mut self.bodies),
+                PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
+                PassItem::PointBatch(k) => {
+                    point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
+                }
                 PassItem::Manifold(first, count) => {
                     let (first, count) = (first as usize, count as usize);
                     for p in &self.points[first..first + count] {
@@ -671,10 +679,13 @@ impl SoftStepSolver {
         // In the plan's order: big islands colour by colour, four manifolds at a time
         // (see `batch`), small ones in the points' order.
         let (items, batches, point_batches) = self.plan.work();
+        let lanes = LanePath::best();
         for item in items {
             match *item {
-                PassItem::Batch(k) => batches[k as usize].solve(&mut self.bodies, &pass),
-                PassItem::PointBatch(k) => point_batches[k as usize].solve(&mut self.bodies, &pass),
+                PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, &pass),
+                PassItem::PointBatch(k) => {
+                    point_batches[k as usize].solve_on(lanes, &mut self.bodies, &pass)
+                }
                 PassItem::Manifold(first, 2) => {
                     let i = first as usize;
                     let (first, second) = self.points.split_at_mut(i + 1);
@@ -693,9 +704,6 @@ impl SoftStepSolver {
     /// A flat face landing bounces on both corners at once: solved one corner at a time,
     /// the first would tip the body and the second bounce less.
     fn restitution(&mut self, bounce_below: f64) {
-        if !self.may_bounce {
-            return;
-        }
         let bounces = |p: &PointConstraint| {
             p.restitution != 0.0
                 && p.relative_velocity <= -bounce_below

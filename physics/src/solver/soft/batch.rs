@@ -197,6 +197,7 @@ impl PassPlan {
         );
         std::mem::swap(&mut self.coloured, &mut self.by_colour);
         // Two-point and one-point manifolds fill their own batches, colour by colour.
+        let pad_from = LanePath::best().fewest_padded();
         let mut i = 0;
         while i < self.coloured.len() {
             let colour = self.coloured[i].0;
@@ -210,7 +211,6 @@ impl PassPlan {
                     _ => self.singles.take(first, (points, bodies), items),
                 }
             }
-            let pad_from = LanePath::best().fewest_padded();
             self.pairs
                 .end_colour((points, bodies), &mut self.items, pad_from);
             self.singles
@@ -709,19 +709,8 @@ impl LanePath {
 }
 
 impl<const N: usize> ManifoldBatch<N> {
-    /// `warm_start` for the batch's points.
-    #[inline(always)]
-    pub(super) fn warm_start(&self, bodies: &mut [SoftBody]) {
-        self.warm_start_on(LanePath::best(), bodies)
-    }
-
-    /// `solve_pair` (or `solve_point`) on every lane.
-    #[inline(always)]
-    pub(super) fn solve(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        self.solve_on(LanePath::best(), bodies, pass)
-    }
-
-    /// `warm_start` with the lanes of `path`, which this processor must run.
+    /// `warm_start` for the batch's points, with the lanes of `path`, which this processor
+    /// must run (`LanePath::best`).
     pub(super) fn warm_start_on(&self, path: LanePath, bodies: &mut [SoftBody]) {
         match path {
             LanePath::Portable => self.warm_start_lanes(bodies),
@@ -733,7 +722,8 @@ impl<const N: usize> ManifoldBatch<N> {
         }
     }
 
-    /// `solve` with the lanes of `path`, which this processor must run.
+    /// `solve_pair` (or `solve_point`) on every lane, with the lanes of `path`, as
+    /// `warm_start_on`.
     pub(super) fn solve_on(
         &mut self,
         path: LanePath,
@@ -1505,22 +1495,14 @@ mod tests {
         for (a, b) in pairs {
             points.extend(manifold(&mut numbers, &bodies, (a, b), Vec2::new(0.0, 1.0)));
         }
-        bodies.push(null_body());
+        bodies.push(SoftBody::null());
         (bodies, points)
-    }
-
-    /// The solver's last body, where unused lanes point.
-    fn null_body() -> SoftBody {
-        SoftBody {
-            dq: Rot::new(0.0),
-            ..SoftBody::default()
-        }
     }
 
     #[test]
     fn a_batch_writes_the_impulses_into_its_contacts_as_its_points_would() {
         let (mut bodies, mut points) = eight_manifolds(3);
-        bodies.push(null_body());
+        bodies.push(SoftBody::null());
         // Contacts numbered against the points' order, so that a mix-up shows.
         for (k, p) in points.iter_mut().enumerate() {
             p.contact = 15 - k as u32;
@@ -1528,7 +1510,7 @@ mod tests {
         let firsts = [0, 2, 4, 6, 8, PAD, PAD, PAD];
         let mut batch = ManifoldBatch::<2>::default();
         batch.fill(firsts, &points, &bodies);
-        batch.solve(&mut bodies, &pass(true));
+        batch.solve_on(LanePath::best(), &mut bodies, &pass(true));
         let contact = Contact {
             body_a: 0,
             body_b: 0,
@@ -1563,7 +1545,7 @@ mod tests {
     fn a_batch_with_unused_lanes_solves_its_manifolds_and_leaves_the_null_body() {
         for seed in 1..=100u64 {
             let (mut bodies, points) = eight_manifolds_both_ways(seed);
-            bodies.push(null_body());
+            bodies.push(SoftBody::null());
             // Three manifolds of the eight, then five unused lanes.
             let firsts = [0, 2, 4, PAD, PAD, PAD, PAD, PAD];
             for use_bias in [true, false] {

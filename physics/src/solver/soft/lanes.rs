@@ -2,7 +2,7 @@
 //! the compiler vectorises, on any processor; `avx2::F64x8Avx2`, the same numbers in two
 //! 256-bit registers, inside the functions compiled for AVX2; and `avx512::F64x8Avx512`,
 //! in one 512-bit register, inside those compiled for AVX-512 (chosen at run time, see
-//! `ManifoldBatch::solve`). Every lane rounds as the scalar code does, so all three give
+//! `batch::LanePath::best`). Every lane rounds as the scalar code does, so all three give
 //! the same bits.
 
 use super::{BodyRow, SoftBody};
