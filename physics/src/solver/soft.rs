@@ -676,7 +676,7 @@ impl SoftStepSolver {
         };
         self.contact_lcp
             .solve(&mut self.bodies, &mut self.points, &pass);
-        // In the plan's order: big islands colour by colour, four manifolds at a time
+        // In the plan's order: big islands colour by colour, eight manifolds at a time
         // (see `batch`), small ones in the points' order.
         let (items, batches, point_batches) = self.plan.work();
         let lanes = LanePath::best();
