@@ -172,8 +172,9 @@ fn main() {
     write_doc(docs, "results.md", &report);
 }
 
-/// `pe <scene> [solver] [fresh]`: one pile, grid or smash scene in pe alone, so that a
-/// profiler sees only pe's step (`fresh`: no manifold reuse).
+/// `pe <scene> [solver] [fresh] [forwards]`: one pile, grid or smash scene in pe alone, so
+/// that a profiler sees only pe's step (`fresh`: no manifold reuse; `forwards`: the soft
+/// step sweeps its colours in one order only).
 fn run_pe_alone() {
     let scene = std::env::args().nth(2).unwrap_or_default();
     let solver_name = std::env::args().nth(3).unwrap_or_else(|| "soft".into());
@@ -181,8 +182,10 @@ fn run_pe_alone() {
         eprintln!("unknown solver {solver_name:?}");
         std::process::exit(2);
     };
+    let flags: Vec<String> = std::env::args().skip(4).collect();
     let config = PeConfig {
-        reuse_manifolds: std::env::args().nth(4).as_deref() != Some("fresh"),
+        reuse_manifolds: !flags.iter().any(|f| f == "fresh"),
+        soft_alternating_sweeps: !flags.iter().any(|f| f == "forwards"),
         ..PeConfig::new(solver)
     };
     let outcome = if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
@@ -204,7 +207,9 @@ fn run_pe_alone() {
 /// turns for a few rounds so that all three see the machine in the same states, printing
 /// each round's medians and the ratios (a quick check while working on the soft step).
 fn run_pile_with_peers() {
-    let scene = std::env::args().nth(2).unwrap_or_else(|| "pyramid20".into());
+    let scene = std::env::args()
+        .nth(2)
+        .unwrap_or_else(|| "pyramid20".into());
     let rounds: usize = std::env::args()
         .nth(3)
         .and_then(|r| r.parse().ok())

@@ -13,12 +13,14 @@ use pe::{
 };
 
 /// How pe is set up for a run: the contact solver, the integrator, the soft step's
-/// substeps (used by `soft` only), and whether the narrow phase reuses manifolds.
+/// substeps and sweep order (used by `soft` only), and whether the narrow phase reuses
+/// manifolds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PeConfig {
     pub solver: ContactSolver,
     pub integrator: Integrator,
     pub soft_substeps: usize,
+    pub soft_alternating_sweeps: bool,
     pub reuse_manifolds: bool,
 }
 
@@ -30,6 +32,7 @@ impl PeConfig {
             solver,
             integrator: defaults.integrator,
             soft_substeps: defaults.soft_substeps,
+            soft_alternating_sweeps: defaults.soft_alternating_sweeps,
             reuse_manifolds: defaults.reuse_manifolds,
         }
     }
@@ -51,6 +54,7 @@ fn world(config: PeConfig) -> World {
     w.settings.contact_solver = config.solver;
     w.settings.integrator = config.integrator;
     w.settings.soft_substeps = config.soft_substeps;
+    w.settings.soft_alternating_sweeps = config.soft_alternating_sweeps;
     w.settings.reuse_manifolds = config.reuse_manifolds;
     // All bodies are metre-sized: pe's tolerances (contact margin, slop, joint tolerance)
     // scale with this.

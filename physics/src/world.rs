@@ -48,6 +48,10 @@ pub struct StepSettings {
     /// Whether a pair that has barely moved relative to itself keeps its last manifold's
     /// features instead of a new separating-axis test (see `collide::reuse`).
     pub reuse_manifolds: bool,
+    /// Whether the soft step sweeps a big island's colours backwards every other pair of
+    /// substeps, against the sway that one fixed order builds in a pile (see
+    /// `solver::soft::SweepOrder`).
+    pub soft_alternating_sweeps: bool,
 }
 
 impl Default for StepSettings {
@@ -62,6 +66,7 @@ impl Default for StepSettings {
             continuous: true,
             soft_substeps: 4,
             reuse_manifolds: true,
+            soft_alternating_sweeps: true,
         }
     }
 }
@@ -1218,6 +1223,7 @@ impl World {
         s.soft.step(
             &SoftSettings {
                 substeps: self.settings.soft_substeps.max(1),
+                alternating_sweeps: self.settings.soft_alternating_sweeps,
                 ..SoftSettings::for_length_scale(self.settings.length_scale)
             },
             &mut s.solver_bodies,
