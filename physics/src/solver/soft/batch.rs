@@ -12,11 +12,12 @@
 //! solved one after another, whichever lanes the processor has. Small islands keep the
 //! points' order, one manifold at a time.
 //!
-//! Against the points' order (by body pair: a pile's bottom row first), colours stand the
-//! 20- and 40-row pyramids stiller (top drift 0.0023 and 0.0018 of a box after 500 steps,
-//! against 0.0036 and 0.016) but the 100-row one less still (largest drift 36% of a box,
-//! against 12%; Box2D v3 0.4%), and without manifold reuse 1,038 of its boxes fall (none
-//! in the points' order): see docs/bench/profile.md.
+//! Against the points' order (by body pair: a pile's bottom row first), colours swept
+//! always first to last stood the 20- and 40-row pyramids stiller (top drift 0.0023 and
+//! 0.0018 of a box after 500 steps, against 0.0036 and 0.016) but the 100-row one less
+//! still (largest drift 36% of a box, against 12%; Box2D v3 0.4%). Swept both ways
+//! (`SweepOrder`), the colours hold the 100-row pyramid's top within 2.2% of a box: see
+//! docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
 use super::avx2::F64x8Avx2;
