@@ -303,7 +303,9 @@ pub struct SoftStepSolver {
     pub reports: Vec<IslandReport>,
 }
 
-/// The direction of a substep's two sweeps (biased, then relaxed) over the colours.
+/// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
+/// big islands (the small ones keep the points' order: a stack's bottom first, which
+/// holds the sweep's stacks a little closer to their rest).
 ///
 /// Gauss–Seidel leaves the constraints it solved last best satisfied, and the greedy
 /// colouring, made in the same order every step, ties colours to places in a pile: swept
@@ -717,11 +719,13 @@ impl SoftStepSolver {
         };
         self.contact_lcp
             .solve(&mut self.bodies, &mut self.points, &pass);
-        // In the plan's order (or against it): big islands colour by colour, eight
-        // manifolds at a time (see `batch`), small ones in the points' order.
+        // In the plan's order: small islands in the points' order, then big ones colour
+        // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
+        let coloured_from = self.plan.coloured_from;
         let (items, batches, point_batches) = self.plan.work();
+        let (small, coloured) = items.split_at(coloured_from);
         let lanes = LanePath::best();
-        let solve_item = |item: &PassItem| match *item {
+        let mut solve_item = |item: &PassItem| match *item {
             PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, &pass),
             PassItem::PointBatch(k) => {
                 point_batches[k as usize].solve_on(lanes, &mut self.bodies, &pass)
@@ -735,9 +739,10 @@ impl SoftStepSolver {
                 solve_point(&mut self.bodies, &mut self.points[first as usize], &pass)
             }
         };
+        small.iter().for_each(&mut solve_item);
         match order {
-            SweepOrder::Forwards => items.iter().for_each(solve_item),
-            SweepOrder::Backwards => items.iter().rev().for_each(solve_item),
+            SweepOrder::Forwards => coloured.iter().for_each(solve_item),
+            SweepOrder::Backwards => coloured.iter().rev().for_each(solve_item),
         }
     }
 

@@ -56,6 +56,9 @@ pub(super) enum PassItem {
 #[derive(Debug, Clone, Default)]
 pub(super) struct PassPlan {
     pub items: Vec<PassItem>,
+    /// Where the coloured islands' items start in `items` (the small islands' come
+    /// first, in the points' order).
+    pub coloured_from: usize,
     /// Batches of two-point and of one-point manifolds.
     pairs: BatchPool<2>,
     singles: BatchPool<1>,
@@ -185,6 +188,7 @@ impl PassPlan {
                     .push(PassItem::Manifold(input.first, input.count()));
             }
         }
+        self.coloured_from = self.items.len();
         // Grouped by colour, each colour in the points' order (a counting sort: the
         // colours are few, a big pile's manifolds many).
         let colour = |&(c, _, _): &(u32, u32, u32)| c as usize;
