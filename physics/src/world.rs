@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
-use crate::collide::{Aabb, BroadPhase, Manifold, WorldPolygon, collide_polygons};
+use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
@@ -185,8 +185,9 @@ pub struct World {
     pub settings: StepSettings,
     step_count: u64,
     joints: Vec<Option<Joint>>,
-    /// Body pairs `(i, j)`, `i < j`, that a joint keeps from colliding; sorted.
-    non_colliding: Vec<(u32, u32)>,
+    /// Body pairs `(i, j)`, `i < j`, that a joint or `ignore_collisions` keeps from
+    /// colliding.
+    non_colliding: PairSet,
     /// Bodies with at least one joint, sorted.
     jointed: Vec<u32>,
     /// The joints or ignored pairs changed since `non_colliding` and `jointed` were built:
@@ -451,8 +452,7 @@ impl World {
         );
         self.jointed.sort_unstable();
         self.jointed.dedup();
-        self.non_colliding.clear();
-        self.non_colliding.extend(
+        self.non_colliding.rebuild(
             self.joints
                 .iter()
                 .flatten()
@@ -463,8 +463,6 @@ impl World {
                 })
                 .chain(self.ignored_pairs.iter().copied()),
         );
-        self.non_colliding.sort_unstable();
-        self.non_colliding.dedup();
     }
 
     /// Bodies `a` and `b` never collide with each other (e.g. a mechanism's parts that
@@ -652,7 +650,7 @@ impl World {
                 // A static body this one never collides with (a robot's pivot that its
                 // own links pass over) is no obstacle.
                 let pair = ((i as u32).min(*obstacle), (i as u32).max(*obstacle));
-                if self.non_colliding.binary_search(&pair).is_ok() {
+                if self.non_colliding.contains(pair) {
                     continue;
                 }
                 // Ending in contact (within the solver's slop either way) is the contact
@@ -1402,8 +1400,7 @@ impl World {
             s.fat_fixed.extend((0..bodies.len()).map(is_fixed));
             let non_colliding = &self.non_colliding;
             let wanted = |i: usize, j: usize| {
-                !(is_fixed(i) && is_fixed(j))
-                    && non_colliding.binary_search(&(i as u32, j as u32)).is_err()
+                !(is_fixed(i) && is_fixed(j)) && !non_colliding.contains((i as u32, j as u32))
             };
             s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
         }

@@ -1,11 +1,13 @@
 //! Collision detection: bounds, the broad phase and the SAT narrow phase (SPEC §3.1).
 
 mod broad;
+mod pair_set;
 pub mod reuse;
 mod sat;
 pub mod toi;
 
 pub use broad::BroadPhase;
+pub use pair_set::PairSet;
 pub use sat::collide_polygons;
 
 use crate::body::{Body, BodyHandle};
