@@ -1400,7 +1400,8 @@ impl World {
             s.fat_fixed.extend((0..bodies.len()).map(is_fixed));
             let non_colliding = &self.non_colliding;
             let wanted = |i: usize, j: usize| {
-                !(is_fixed(i) && is_fixed(j)) && !non_colliding.contains((i as u32, j as u32))
+                let both_fixed = is_fixed(i) && is_fixed(j);
+                !both_fixed && !non_colliding.contains((i as u32, j as u32))
             };
             s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
         }
