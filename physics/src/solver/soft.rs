@@ -543,6 +543,10 @@ impl SoftStepSolver {
                     Ok(k) => (self.joint_memory[k].1, self.joint_memory[k].2),
                     Err(_) => (Vec2::zeros(), 0.0),
                 };
+            let motor = j
+                .motor
+                .filter(|m| m.enabled)
+                .map(|m| (m.target_speed, m.max_torque));
             self.joints.push(SoftJoint {
                 a: j.body_a,
                 b: j.body_b,
@@ -553,12 +557,11 @@ impl SoftStepSolver {
                 // repair broken joints over several steps does not apply here.
                 base_gap: (a.position + r_a) - (b.position + r_b),
                 impulse,
-                motor_impulse,
+                // Warm starting applies the remembered motor impulse in every substep: a
+                // motor switched off or removed must not keep driving its joint with it.
+                motor_impulse: if motor.is_some() { motor_impulse } else { 0.0 },
                 motor_step_total: 0.0,
-                motor: j
-                    .motor
-                    .filter(|m| m.enabled)
-                    .map(|m| (m.target_speed, m.max_torque)),
+                motor,
                 slot: j.joint,
                 input: input as u32,
             });
