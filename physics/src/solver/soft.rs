@@ -264,6 +264,58 @@ struct SoftJoint {
     input: u32,
 }
 
+/// Last step's pin impulses (linear, and the motor's angular one) by joint slot.
+#[derive(Debug, Clone, Default)]
+struct JointMemory {
+    /// `(slot, impulse, motor impulse)`, sorted by slot.
+    entries: Vec<(u32, Vec2, f64)>,
+    /// This step's, by the pin's index among the step's input joints (`Self::NONE`'s slot
+    /// where it keeps none), until `finish` makes them the entries.
+    by_input: Vec<(u32, Vec2, f64)>,
+}
+
+impl JointMemory {
+    const NONE: (u32, Vec2, f64) = (u32::MAX, Vec2::new(0.0, 0.0), 0.0);
+
+    /// Starts a step of `inputs` joints; `recall` still reads the last step's.
+    fn begin(&mut self, inputs: usize) {
+        self.by_input.clear();
+        self.by_input.resize(inputs, Self::NONE);
+    }
+
+    /// The pin `slot`'s impulses of the last step. The step's joints come in slot order,
+    /// so `cursor` walks the entries once; a pin found behind it is searched for.
+    fn recall(&self, slot: u32, cursor: &mut usize) -> Option<(u32, Vec2, f64)> {
+        while self.entries.get(*cursor).is_some_and(|m| m.0 < slot) {
+            *cursor += 1;
+        }
+        match self.entries.get(*cursor) {
+            Some(&m) if m.0 == slot => Some(m),
+            _ => self
+                .entries
+                .binary_search_by_key(&slot, |m| m.0)
+                .ok()
+                .map(|k| self.entries[k]),
+        }
+    }
+
+    /// Keeps the impulses of the step's input joint `input` for the next step.
+    fn keep(&mut self, input: u32, entry: (u32, Vec2, f64)) {
+        self.by_input[input as usize] = entry;
+    }
+
+    /// The kept impulses become the ones to recall.
+    fn finish(&mut self) {
+        self.entries.clear();
+        let kept = self.by_input.iter().filter(|e| e.0 != Self::NONE.0);
+        self.entries.extend(kept);
+        // Input order is slot order, unless a caller gave the joints otherwise.
+        if !self.entries.is_sorted_by_key(|e| e.0) {
+            self.entries.sort_unstable_by_key(|e| e.0);
+        }
+    }
+}
+
 /// Warm-start memory and buffers, kept between steps.
 #[derive(Debug, Clone, Default)]
 pub struct SoftStepSolver {
@@ -274,10 +326,9 @@ pub struct SoftStepSolver {
     /// Last step's contact impulses, and this step's contacts' share of them.
     memory: ContactMemory,
     recalled: Vec<(f64, f64)>,
-    joint_memory: Vec<(u32, Vec2, f64)>,
-    /// The memory of pins left out this step (both bodies fixed: asleep, or held under
-    /// `auto`), kept so that they warm-start again when their bodies move.
-    skipped_joint_memory: Vec<(u32, Vec2, f64)>,
+    joint_memory: JointMemory,
+    /// `joints` indices of the pins with a motor, in `joints`' order.
+    motor_joints: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
@@ -390,7 +441,8 @@ impl SoftStepSolver {
             self.solve(h, &contact_soft, &joint_soft, settings, false, order);
             // Warm starting re-applies the accumulated impulse in every substep, so the
             // step's total is the sum of the substeps' accumulated values.
-            for j in &mut self.joints {
+            for &k in &self.motor_joints {
+                let j = &mut self.joints[k as usize];
                 j.motor_step_total += j.motor_impulse;
             }
         }
@@ -523,26 +575,24 @@ impl SoftStepSolver {
             &self.bodies,
         );
         self.joints.clear();
-        self.skipped_joint_memory.clear();
+        self.joint_memory.begin(joints.len());
+        let mut cursor = 0;
         for (input, j) in joints.iter().enumerate() {
             let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
             // A pin between two fixed bodies (asleep, or held for the other solver's pass
             // under `auto`) can do nothing: it is left out, so neither its island nor its
             // motor's reading (the other pass's) is touched.
             let fixed = |b: &SolverBody| b.inv_mass == 0.0 && b.inv_inertia == 0.0;
+            let remembered = self.joint_memory.recall(j.joint, &mut cursor);
             if fixed(a) && fixed(b) {
-                let memory = self.joint_memory.binary_search_by(|m| m.0.cmp(&j.joint));
-                if let Ok(k) = memory {
-                    self.skipped_joint_memory.push(self.joint_memory[k]);
+                // Kept, so that the pin warm-starts again when its bodies move.
+                if let Some(entry) = remembered {
+                    self.joint_memory.keep(input as u32, entry);
                 }
                 continue;
             }
             let (r_a, r_b) = j.arms((a.angle, b.angle));
-            let (impulse, motor_impulse) =
-                match self.joint_memory.binary_search_by(|m| m.0.cmp(&j.joint)) {
-                    Ok(k) => (self.joint_memory[k].1, self.joint_memory[k].2),
-                    Err(_) => (Vec2::zeros(), 0.0),
-                };
+            let (_, impulse, motor_impulse) = remembered.unwrap_or(JointMemory::NONE);
             let motor = j
                 .motor
                 .filter(|m| m.enabled)
@@ -567,6 +617,13 @@ impl SoftStepSolver {
             });
         }
         self.group_joints();
+        self.motor_joints.clear();
+        let motors = self
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.motor.is_some());
+        self.motor_joints.extend(motors.map(|(k, _)| k as u32));
     }
 
     /// Records how each island of contacts and of pins was solved.
@@ -698,8 +755,8 @@ impl SoftStepSolver {
     ) {
         let (max_push, joint_push) = (settings.max_push_speed, settings.joint_push_speed);
         let inv_h = 1.0 / h;
-        for j in self.joints.iter_mut() {
-            solve_motor(&mut self.bodies, j, h);
+        for &k in &self.motor_joints {
+            solve_motor(&mut self.bodies, &mut self.joints[k as usize], h);
         }
         for &(start, end) in &self.joint_islands {
             let island = &mut self.joints[start..end];
@@ -830,17 +887,15 @@ impl SoftStepSolver {
             }
         }
         self.memory.store(contacts);
-        self.joint_memory.clear();
         for j in &self.joints {
-            self.joint_memory.push((j.slot, j.impulse, j.motor_impulse));
+            self.joint_memory
+                .keep(j.input, (j.slot, j.impulse, j.motor_impulse));
             if let Some(m) = joints[j.input as usize].motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
                 m.step_impulse = j.motor_step_total;
             }
         }
-        self.joint_memory
-            .extend_from_slice(&self.skipped_joint_memory);
-        self.joint_memory.sort_unstable_by_key(|x| x.0);
+        self.joint_memory.finish();
     }
 }
 
