@@ -206,6 +206,15 @@ pub struct World {
     scratch: Scratch,
 }
 
+/// Whether gathering the joints works out the gap each is to close (`gap_target`): the
+/// exact and thesis solvers repair a broken joint over several steps; the soft step
+/// pulls every pin closed its own way and never reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum GapTargets {
+    ForBrokenJoints,
+    None,
+}
+
 /// The two stage lists of a step: impulses (`sequential`, `thesis`, `exact`) and the soft
 /// step. Under `auto` both run in one step on different islands, each finding its own
 /// contacts, so each keeps its own manifolds for reuse.
@@ -1207,7 +1216,8 @@ impl World {
     fn step_soft(&mut self, dt: f64) {
         self.scratch.start_velocities.clear(); // forces act inside the substeps
         self.detect_contacts(dt, Pipeline::Soft);
-        self.gather_solver_bodies();
+        // The soft step pulls every pin closed its own way: no repair targets.
+        self.gather_solver_bodies_with(GapTargets::None);
         let s = &mut self.scratch;
         s.accelerations.clear();
         s.accelerations.extend(self.bodies.iter().map(|b| match b {
@@ -1235,8 +1245,12 @@ impl World {
     }
 
     /// Copies the bodies into the solver array, the static world last, and resolves the
-    /// joints to slots in it.
+    /// joints to slots in it, each with the gap it is to close this step.
     fn gather_solver_bodies(&mut self) {
+        self.gather_solver_bodies_with(GapTargets::ForBrokenJoints);
+    }
+
+    fn gather_solver_bodies_with(&mut self, targets: GapTargets) {
         let s = &mut self.scratch;
         s.solver_bodies.clear();
         s.solver_bodies.extend(
@@ -1262,9 +1276,11 @@ impl World {
                 motor: j.motor,
                 gap_target: Vec2::zeros(),
             };
-            let gap_now = c.predicted_gap(&s.solver_bodies, 0.0);
-            c.gap_target =
-                velocity_gap_target(gap_now, self.settings.joint_iterations(1.0).broken_gap);
+            if targets == GapTargets::ForBrokenJoints {
+                let gap_now = c.predicted_gap(&s.solver_bodies, 0.0);
+                let broken_gap = self.settings.joint_iterations(1.0).broken_gap;
+                c.gap_target = velocity_gap_target(gap_now, broken_gap);
+            }
             s.joint_constraints.push(c);
         }
     }

@@ -146,10 +146,13 @@ fn solve_2x2(k: [[f64; 2]; 2], rhs: Vec2) -> Option<Vec2> {
 impl JointConstraint {
     /// World anchor offsets from each centroid, `r_A` and `r_B`.
     pub fn arms(&self, angles: (f64, f64)) -> (Vec2, Vec2) {
-        (
-            Rot::new(angles.0).apply(self.local_anchor_a),
-            Rot::new(angles.1).apply(self.local_anchor_b),
-        )
+        self.arms_turned((Rot::new(angles.0), Rot::new(angles.1)))
+    }
+
+    /// `arms` for bodies turned by the given rotations (found once per body, where the
+    /// bodies carry many pins).
+    pub fn arms_turned(&self, (a, b): (Rot, Rot)) -> (Vec2, Vec2) {
+        (a.apply(self.local_anchor_a), b.apply(self.local_anchor_b))
     }
 
     /// Removes the anchors' relative velocity (SPEC eq. 40). Returns |d_v| before.

@@ -327,6 +327,8 @@ pub struct SoftStepSolver {
     memory: ContactMemory,
     recalled: Vec<(f64, f64)>,
     joint_memory: JointMemory,
+    /// The bodies' rotations at the step's start (filled only when there are pins).
+    rotations: Vec<Rot>,
     /// `joints` indices of the pins with a motor, in `joints`' order.
     motor_joints: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
@@ -574,6 +576,12 @@ impl SoftStepSolver {
             &self.points,
             &self.bodies,
         );
+        // Each body's rotation once: a body of a net carries four pins.
+        self.rotations.clear();
+        if !joints.is_empty() {
+            self.rotations
+                .extend(bodies.iter().map(|b| Rot::new(b.angle)));
+        }
         self.joints.clear();
         self.joint_memory.begin(joints.len());
         let mut cursor = 0;
@@ -591,7 +599,8 @@ impl SoftStepSolver {
                 }
                 continue;
             }
-            let (r_a, r_b) = j.arms((a.angle, b.angle));
+            let turned = |i: u32| self.rotations[i as usize];
+            let (r_a, r_b) = j.arms_turned((turned(j.body_a), turned(j.body_b)));
             let (_, impulse, motor_impulse) = remembered.unwrap_or(JointMemory::NONE);
             let motor = j
                 .motor
