@@ -203,9 +203,10 @@ fn run_pe_alone() {
     println!("{scene} under pe {}: {outcome:?}", solver.name());
 }
 
-/// `pile <pyramid scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile, taking
-/// turns for a few rounds so that all three see the machine in the same states, printing
-/// each round's medians and the ratios (a quick check while working on the soft step).
+/// `pile <scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile (or the joint grid,
+/// or the smash), taking turns for a few rounds so that all three see the machine in the
+/// same states, printing each round's medians and the ratios (a quick check while working
+/// on the soft step).
 fn run_pile_with_peers() {
     let scene = std::env::args()
         .nth(2)
@@ -214,15 +215,35 @@ fn run_pile_with_peers() {
         .nth(3)
         .and_then(|r| r.parse().ok())
         .unwrap_or(3);
-    let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) else {
-        let names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
-        eprintln!("unknown pile {scene:?}: one of {}", names.join(", "));
-        std::process::exit(2);
-    };
+    let pe = PeConfig::new(ContactSolver::Soft);
+    type Run = Box<dyn Fn() -> Outcome>;
+    let (pe_run, rapier_run, box2d_run): (Run, Run, Run) =
+        if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
+            (
+                Box::new(move || pe_scenes::pyramid(pe, spec, H)),
+                Box::new(move || rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS)),
+                Box::new(move || box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS)),
+            )
+        } else if scene == joint_grid::NAME {
+            (
+                Box::new(move || pe_scenes::joint_grid(pe)),
+                Box::new(rapier_scenes::joint_grid),
+                Box::new(box2d_scenes::joint_grid),
+            )
+        } else if scene == smash::NAME {
+            (
+                Box::new(move || pe_scenes::smash(pe)),
+                Box::new(rapier_scenes::smash),
+                Box::new(box2d_scenes::smash),
+            )
+        } else {
+            let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
+            names.extend([joint_grid::NAME, smash::NAME]);
+            eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
+            std::process::exit(2);
+        };
     for round in 1..=rounds {
-        let pe = pe_scenes::pyramid(PeConfig::new(ContactSolver::Soft), spec, H);
-        let rapier = rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS);
-        let box2d = box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS);
+        let (pe, rapier, box2d) = (pe_run(), rapier_run(), box2d_run());
         println!(
             "{scene} round {round}: pe soft {} ({}), rapier2d {} ({}), Box2D v3 {} ({}); \
              pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
