@@ -327,8 +327,8 @@ pub struct SoftStepSolver {
     memory: ContactMemory,
     recalled: Vec<(f64, f64)>,
     joint_memory: JointMemory,
-    /// The bodies' rotations at the step's start (filled only when there are pins).
-    rotations: Vec<Rot>,
+    /// The pinned bodies' rotations at the step's start, found as the pins need them.
+    rotations: Vec<Option<Rot>>,
     /// `joints` indices of the pins with a motor, in `joints`' order.
     motor_joints: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
@@ -576,11 +576,10 @@ impl SoftStepSolver {
             &self.points,
             &self.bodies,
         );
-        // Each body's rotation once: a body of a net carries four pins.
+        // Each pinned body's rotation once: a body of a net carries four pins.
         self.rotations.clear();
         if !joints.is_empty() {
-            self.rotations
-                .extend(bodies.iter().map(|b| Rot::new(b.angle)));
+            self.rotations.resize(bodies.len(), None);
         }
         self.joints.clear();
         self.joint_memory.begin(joints.len());
@@ -599,7 +598,10 @@ impl SoftStepSolver {
                 }
                 continue;
             }
-            let turned = |i: u32| self.rotations[i as usize];
+            let mut turned = |i: u32| {
+                *self.rotations[i as usize]
+                    .get_or_insert_with(|| Rot::new(bodies[i as usize].angle))
+            };
             let (r_a, r_b) = j.arms_turned((turned(j.body_a), turned(j.body_b)));
             let (_, impulse, motor_impulse) = remembered.unwrap_or(JointMemory::NONE);
             let motor = j
