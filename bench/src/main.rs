@@ -242,8 +242,11 @@ fn run_pile_with_peers() {
             eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
             std::process::exit(2);
         };
+    let mut ratios = Vec::with_capacity(rounds);
     for round in 1..=rounds {
         let (pe, rapier, box2d) = (pe_run(), rapier_run(), box2d_run());
+        let of = |peer: &Outcome| pe.timing.median.as_secs_f64() / peer.timing.median.as_secs_f64();
+        ratios.push((of(&rapier), of(&box2d)));
         println!(
             "{scene} round {round}: pe soft {} ({}), rapier2d {} ({}), Box2D v3 {} ({}); \
              pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
@@ -257,6 +260,20 @@ fn run_pile_with_peers() {
             ratio(pe.timing.median, box2d.timing.median),
         );
     }
+    let range = |pick: fn(&(f64, f64)) -> f64| {
+        let (lo, hi) = ratios
+            .iter()
+            .map(pick)
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| {
+                (lo.min(r), hi.max(r))
+            });
+        format!("{lo:.2}–{hi:.2}")
+    };
+    println!(
+        "{scene} over {rounds} rounds: pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
+        range(|r| r.0),
+        range(|r| r.1)
+    );
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
