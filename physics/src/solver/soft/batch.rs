@@ -81,6 +81,10 @@ pub(super) struct PassPlan {
     /// Whether this step's manifolds were written into the kept plan's lanes as they
     /// were built (`begin_filling`), so that `plan` need not fill the batches again.
     filled_while_built: bool,
+    /// Whether the last step kept the plan before it. One that changed will most likely
+    /// change again (debris in flight: every step of the smash), and its lanes are then
+    /// filled once the new plan is made rather than also while the points are built.
+    kept_last_step: bool,
 }
 
 /// No batch lane: the manifold is solved alone, or in an LCP island.
@@ -160,7 +164,8 @@ impl PassPlan {
     ) {
         self.read_inputs(islands, manifolds, points);
         let filled_while_built = std::mem::take(&mut self.filled_while_built);
-        if self.inputs == self.last_inputs {
+        self.kept_last_step = self.inputs == self.last_inputs;
+        if self.kept_last_step {
             // A pile at rest: the same manifolds between the same bodies.
             if !filled_while_built {
                 for batch in self.pairs.filled_mut() {
@@ -241,10 +246,14 @@ impl PassPlan {
     }
 
     /// Starts a step whose manifolds are then written into the kept plan's lanes as they
-    /// are built (`fill_manifold`). If the plan turns out to change, `plan` makes and
-    /// fills the new one as usual.
+    /// are built (`fill_manifold`), if the last step kept its plan. If the plan turns out
+    /// to change, `plan` makes and fills the new one as usual; if it is kept after a
+    /// change, `plan` fills it from the points.
     pub fn begin_filling(&mut self) {
-        self.filled_while_built = true;
+        self.filled_while_built = self.kept_last_step;
+        if !self.filled_while_built {
+            return;
+        }
         for batch in self.pairs.filled_mut() {
             batch.may_bounce = false;
         }
@@ -263,6 +272,9 @@ impl PassPlan {
         points: &[PointConstraint],
         bodies: &[SoftBody],
     ) {
+        if !self.filled_while_built {
+            return;
+        }
         let Some(&slot) = self.slot_of.get(first).filter(|&&s| s != NO_SLOT) else {
             return;
         };
