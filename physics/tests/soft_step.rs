@@ -56,31 +56,27 @@ fn a_pyramid_of_twenty_rows_stands_ten_seconds() {
 }
 
 #[test]
-fn sweeping_the_colours_both_ways_keeps_a_pyramid_still() {
-    // A pile has no sideways load: any sway of its top box is the solver's. Swept always
-    // in one order, the greedy colours push the 20-row pyramid's top box up to 0.0076 of
-    // a width aside in 500 steps; alternating, 0.0006.
-    let largest_sway = |alternating: bool| {
+fn a_pyramid_of_forty_rows_stands_without_swaying() {
+    // A pile has no sideways load: any sway of its top box is the solver's. Colours
+    // given greedily in the points' order (row by row) swayed the 40-row pyramid's top
+    // box up to 0.033 of a width in 500 steps, 0.0036 with the sweeps alternating;
+    // coloured in a scattered order, 0.0012 alternating and 0.0007 swept one way (Box2D
+    // v3: 0.0043).
+    for alternating in [true, false] {
         let mut w = soft_world();
         w.settings.soft_alternating_sweeps = alternating;
-        let boxes = pyramid(&mut w, 20);
+        let boxes = pyramid(&mut w, 40);
         let (top, start) = *boxes.last().unwrap();
         let mut largest: f64 = 0.0;
         for _ in 0..500 {
             w.step(H);
             largest = largest.max((w.body(top).unwrap().position.x - start.x).abs());
         }
-        largest
-    };
-    let (both_ways, forwards) = (largest_sway(true), largest_sway(false));
-    assert!(
-        both_ways < 0.002,
-        "swept both ways, the top swayed {both_ways}"
-    );
-    assert!(
-        both_ways < 0.25 * forwards,
-        "swept both ways {both_ways}, forwards only {forwards}"
-    );
+        assert!(
+            largest < 0.002,
+            "sweeps alternating: {alternating}: the top swayed {largest} widths"
+        );
+    }
 }
 
 /// How deep a body rests on its soft contacts: at rest each substep's impulses x carry

@@ -360,14 +360,14 @@ pub struct SoftStepSolver {
 /// big islands (the small ones keep the points' order: a stack's bottom first, which
 /// holds the sweep's stacks a little closer to their rest).
 ///
-/// Gauss–Seidel leaves the constraints it solved last best satisfied, and the greedy
-/// colouring, made in the same order every step, ties colours to places in a pile: swept
-/// always first to last, the colours push a pile one way. Two substeps forwards, then
-/// two backwards, cancel that (symmetric Gauss–Seidel): the 100-row pyramid's top box
-/// swayed up to 0.23 of a box and ended 0.038 off, and now sways up to 0.022 and ends
-/// 0.006 off (Box2D v3: 0.0094 and 0.0041). Flipping every substep helped less (largest
-/// sway 0.086) and flipping only the relax pass less still (0.15): see
-/// docs/bench/profile.md.
+/// Gauss–Seidel leaves the constraints it solved last best satisfied: swept always
+/// first to last, the colours favour some constraints over others at every step. Two
+/// substeps forwards, then two backwards, cancel that to first order (symmetric
+/// Gauss–Seidel). With the colours given in the points' order, it took the 100-row
+/// pyramid's largest top sway from 0.23 of a box to 0.022; flipping every substep helped
+/// less (0.086), flipping only the relax pass less still (0.15). With the colours
+/// scattered (`batch::PassPlan::colour_in_scattered_order`) the sway is 0.0065 swept one
+/// way and 0.0025 alternating (Box2D v3: 0.0094): see docs/bench/profile.md.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum SweepOrder {
     Forwards,
@@ -556,6 +556,7 @@ impl SoftStepSolver {
                     (c.body_a, c.body_b),
                     k,
                     (moves(c.body_a), moves(c.body_b)),
+                    c.normal,
                 ));
                 // The point before, if it began a manifold, was that manifold's only one.
                 if let Some(single) = open_manifold.replace(k) {

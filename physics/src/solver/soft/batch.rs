@@ -12,12 +12,10 @@
 //! solved one after another, whichever lanes the processor has. Small islands keep the
 //! points' order, one manifold at a time.
 //!
-//! Against the points' order (by body pair: a pile's bottom row first), colours swept
-//! always first to last stood the 20- and 40-row pyramids stiller (top drift 0.0023 and
-//! 0.0018 of a box after 500 steps, against 0.0036 and 0.016) but the 100-row one less
-//! still (largest drift 36% of a box, against 12%; Box2D v3 0.4%). Swept both ways
-//! (`SweepOrder`), the colours hold the 100-row pyramid's top within 2.2% of a box: see
-//! docs/bench/profile.md.
+//! The colours are given in a scattered order (`PassPlan::colour_in_scattered_order`):
+//! given in the points' order, they repeated one pattern across a pile and it swayed. With
+//! that and the sweeps alternating (`SweepOrder`), the 100-row pyramid's top stays within
+//! 0.25% of a box over 500 steps (Box2D v3 0.94%): see docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
 use super::avx2::F64x8Avx2;
@@ -64,12 +62,18 @@ pub(super) struct PassPlan {
     singles: BatchPool<1>,
     /// Per body, a bit for each colour it already has a manifold in.
     colours_of: Vec<u32>,
-    /// `(colour, first point, point count)` of the coloured manifolds.
+    /// `(2 × colour + 1 if sideways, first point, point count)` of the coloured manifolds.
     coloured: Vec<(u32, u32, u32)>,
     /// The counting sort of `coloured` by colour: its output, and where each colour
     /// starts in it.
     by_colour: Vec<(u32, u32, u32)>,
     colour_starts: Vec<u32>,
+    /// The coloured manifolds (indices into `inputs`) in the order they are coloured
+    /// (`colouring_order`), its counting sort's buckets, and each manifold's colour.
+    colouring: Vec<u32>,
+    colouring_scratch: Vec<u32>,
+    colouring_starts: Vec<u32>,
+    colour_by_input: Vec<u32>,
     /// What the last plan was made from, one entry a manifold (`PlanInput`): while it
     /// is unchanged, so is the plan, and only the batches' numbers are read again.
     inputs: Vec<PlanInput>,
@@ -125,15 +129,24 @@ impl PlanInput {
     const COLOURED: u32 = 2;
     const A_MOVES: u32 = 4;
     const B_MOVES: u32 = 8;
+    /// The normal lies nearer the x axis than the y axis (batched apart, see `plan`).
+    const SIDEWAYS: u32 = 16;
 
     /// A one-point manifold (so far) between `a` and `b`, whose point is `first`.
-    pub fn new((a, b): (u32, u32), first: usize, (a_moves, b_moves): (bool, bool)) -> Self {
+    pub fn new(
+        (a, b): (u32, u32),
+        first: usize,
+        (a_moves, b_moves): (bool, bool),
+        normal: Vec2,
+    ) -> Self {
         let flag = |on: bool, flag: u32| if on { flag } else { 0 };
         Self {
             a,
             b,
             first: first as u32,
-            flags: flag(a_moves, Self::A_MOVES) | flag(b_moves, Self::B_MOVES),
+            flags: flag(a_moves, Self::A_MOVES)
+                | flag(b_moves, Self::B_MOVES)
+                | flag(normal.x.abs() > normal.y.abs(), Self::SIDEWAYS),
         }
     }
 
@@ -183,25 +196,35 @@ impl PassPlan {
         self.coloured.clear();
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
+        self.colour_in_scattered_order();
         for k in 0..self.inputs.len() {
             let input = self.inputs[k];
             if input.flags & PlanInput::COLOURED != 0 {
-                let c = self.colour_of(input);
-                self.coloured.push((c, input.first, input.count()));
+                // The sort key below: the colour, then sideways after upright.
+                let sideways = u32::from(input.flags & PlanInput::SIDEWAYS != 0);
+                let key = 2 * self.colour_by_input[k] + sideways;
+                self.coloured.push((key, input.first, input.count()));
             } else {
                 self.items
                     .push(PassItem::Manifold(input.first, input.count()));
             }
         }
         self.coloured_from = self.items.len();
-        // Grouped by colour, each colour in the points' order (a counting sort: the
-        // colours are few, a big pile's manifolds many).
-        let colour = |&(c, _, _): &(u32, u32, u32)| c as usize;
-        let keys = COLOURS as usize; // colours 0..COLOURS (`colour_of`)
+        // Grouped by colour (a counting sort: the colours are few, a big pile's manifolds
+        // many), and in each colour the manifolds whose normal lies nearer the y axis
+        // before those nearer the x axis (`PlanInput::SIDEWAYS`), each in the points'
+        // order. The order within a
+        // colour changes no result; grouping by orientation keeps a pile's supports and
+        // its side contacts in batches of their own, so that fewer batches hold a
+        // manifold whose two points part (one touching, one not), which takes the slower
+        // path (`solve_normals_together`): on the 40-row pyramid at rest 332 of 2,400
+        // batch passes a step, against 504 ungrouped.
+        let key = |&(key, _, _): &(u32, u32, u32)| key as usize;
+        let keys = 2 * COLOURS as usize; // colours 0..COLOURS (`colour_of`), two ways
         counting_sort(
             &self.coloured,
             keys,
-            colour,
+            key,
             &mut self.colour_starts,
             &mut self.by_colour,
         );
@@ -209,9 +232,10 @@ impl PassPlan {
         // Two-point and one-point manifolds fill their own batches, colour by colour.
         let pad_from = LanePath::best().fewest_padded();
         let mut i = 0;
+        let colour_at = |coloured: &[(u32, u32, u32)], i: usize| coloured[i].0 / 2;
         while i < self.coloured.len() {
-            let colour = self.coloured[i].0;
-            while i < self.coloured.len() && self.coloured[i].0 == colour {
+            let colour = colour_at(&self.coloured, i);
+            while i < self.coloured.len() && colour_at(&self.coloured, i) == colour {
                 let (_, first, count) = self.coloured[i];
                 i += 1;
                 let items = &mut self.items;
@@ -367,6 +391,51 @@ impl PassPlan {
             self.pairs.filled_mut(),
             self.singles.filled_mut(),
         )
+    }
+
+    /// Colours the coloured manifolds (`colour_of`) in an order scattered over the pile,
+    /// into `colour_by_input`.
+    ///
+    /// Greedy colouring in the points' order (a pile row by row, left to right: each
+    /// manifold takes the lowest colour its bodies leave free) colours a pile in one
+    /// pattern repeated across it, so the one-sidedness of a Gauss–Seidel sweep over the
+    /// colours adds up over the pile instead of averaging out, and the pile sways. Coloured
+    /// in the order of a hash of their bodies (one counting sort on 8
+    /// bits of it: buckets scattered over the pile, each in the points' order), the
+    /// colours fall anywhere, and the 100-row pyramid's top box sways at most 0.0025 of a
+    /// width in 500 steps and ends 0.0010 off (in the points' order 0.022 and 0.0063;
+    /// Box2D v3 0.0094 and 0.0041): see docs/bench/profile.md. The colours needed, and so
+    /// the batches, stay about as many (2,400 batch passes a step on the 40-row pyramid,
+    /// against 2,376).
+    fn colour_in_scattered_order(&mut self) {
+        const HASH_BITS: u32 = 8;
+        let inputs = &self.inputs;
+        self.colouring.clear();
+        self.colouring.extend(
+            (0..inputs.len() as u32)
+                .filter(|&k| inputs[k as usize].flags & PlanInput::COLOURED != 0),
+        );
+        // Knuth's multiplicative hashing of the body pair; its top bits pick the bucket.
+        let bucket = |&k: &u32| {
+            let m = inputs[k as usize];
+            let h = (m.a.wrapping_mul(0x9E37_79B1) ^ m.b.wrapping_mul(0x85EB_CA77))
+                .wrapping_mul(0xC2B2_AE3D);
+            (h >> (32 - HASH_BITS)) as usize
+        };
+        counting_sort(
+            &self.colouring,
+            1 << HASH_BITS,
+            bucket,
+            &mut self.colouring_starts,
+            &mut self.colouring_scratch,
+        );
+        std::mem::swap(&mut self.colouring, &mut self.colouring_scratch);
+        self.colour_by_input.clear();
+        self.colour_by_input.resize(self.inputs.len(), 0);
+        for i in 0..self.colouring.len() {
+            let k = self.colouring[i] as usize;
+            self.colour_by_input[k] = self.colour_of(self.inputs[k]);
+        }
     }
 
     /// A manifold's colour, counted from 1 (0: none free, solved first), marking it taken
@@ -1490,7 +1559,7 @@ mod tests {
         while first < points.len() {
             let p = &points[first];
             let moves = |i: u32| bodies[i as usize].moves();
-            let mut input = PlanInput::new((p.a, p.b), first, (moves(p.a), moves(p.b)));
+            let mut input = PlanInput::new((p.a, p.b), first, (moves(p.a), moves(p.b)), p.normal);
             if p.pair_coupling.is_some() {
                 input.add_second_point();
             }
