@@ -69,7 +69,8 @@ pub(super) struct PassPlan {
     by_colour: Vec<(u32, u32, u32)>,
     colour_starts: Vec<u32>,
     /// The coloured manifolds (indices into `inputs`) in the order they are coloured
-    /// (`colouring_order`), its counting sort's buckets, and each manifold's colour.
+    /// (`colour_in_scattered_order`), its counting sort's scratch and buckets, and each
+    /// manifold's colour by its index in `inputs`.
     colouring: Vec<u32>,
     colouring_scratch: Vec<u32>,
     colouring_starts: Vec<u32>,
@@ -213,12 +214,11 @@ impl PassPlan {
         // Grouped by colour (a counting sort: the colours are few, a big pile's manifolds
         // many), and in each colour the manifolds whose normal lies nearer the y axis
         // before those nearer the x axis (`PlanInput::SIDEWAYS`), each in the points'
-        // order. The order within a
-        // colour changes no result; grouping by orientation keeps a pile's supports and
-        // its side contacts in batches of their own, so that fewer batches hold a
-        // manifold whose two points part (one touching, one not), which takes the slower
-        // path (`solve_normals_together`): on the 40-row pyramid at rest 332 of 2,400
-        // batch passes a step, against 504 ungrouped.
+        // order. The order within a colour changes no result; grouping by orientation
+        // keeps a pile's supports and its side contacts in batches of their own, so that
+        // fewer batches hold a manifold whose two points part (one touching, one not),
+        // which takes the slower path (`solve_normals_together`): on the 40-row pyramid
+        // at rest 332 of 2,400 batch passes a step, against 504 ungrouped.
         let key = |&(key, _, _): &(u32, u32, u32)| key as usize;
         let keys = 2 * COLOURS as usize; // colours 0..COLOURS (`colour_of`), two ways
         counting_sort(
@@ -400,13 +400,12 @@ impl PassPlan {
     /// manifold takes the lowest colour its bodies leave free) colours a pile in one
     /// pattern repeated across it, so the one-sidedness of a Gauss–Seidel sweep over the
     /// colours adds up over the pile instead of averaging out, and the pile sways. Coloured
-    /// in the order of a hash of their bodies (one counting sort on 8
-    /// bits of it: buckets scattered over the pile, each in the points' order), the
-    /// colours fall anywhere, and the 100-row pyramid's top box sways at most 0.0025 of a
-    /// width in 500 steps and ends 0.0010 off (in the points' order 0.022 and 0.0063;
-    /// Box2D v3 0.0094 and 0.0041): see docs/bench/profile.md. The colours needed, and so
-    /// the batches, stay about as many (2,400 batch passes a step on the 40-row pyramid,
-    /// against 2,376).
+    /// in the order of a hash of their bodies (one counting sort on 8 bits of it: buckets
+    /// scattered over the pile, each in the points' order), the colours fall anywhere,
+    /// and the 100-row pyramid's top box sways at most 0.0025 of a width in 500 steps and
+    /// ends 0.0010 off (in the points' order 0.022 and 0.0063; Box2D v3 0.0094 and
+    /// 0.0041): see docs/bench/profile.md. The colours needed, and so the batches, stay
+    /// about as many (2,400 batch passes a step on the 40-row pyramid, against 2,376).
     fn colour_in_scattered_order(&mut self) {
         const HASH_BITS: u32 = 8;
         let inputs = &self.inputs;
@@ -415,7 +414,8 @@ impl PassPlan {
             (0..inputs.len() as u32)
                 .filter(|&k| inputs[k as usize].flags & PlanInput::COLOURED != 0),
         );
-        // Knuth's multiplicative hashing of the body pair; its top bits pick the bucket.
+        // Multiplicative hashing of the body pair (the golden ratio's and xxHash's odd
+        // constants); its top bits pick the bucket.
         let bucket = |&k: &u32| {
             let m = inputs[k as usize];
             let h = (m.a.wrapping_mul(0x9E37_79B1) ^ m.b.wrapping_mul(0x85EB_CA77))
