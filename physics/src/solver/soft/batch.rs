@@ -1574,6 +1574,12 @@ mod tests {
         inputs
     }
 
+    /// `plan` over `points` as one island, from their entries (`inputs_of`).
+    fn plan_one_island(plan: &mut PassPlan, points: &[PointConstraint], bodies: &[SoftBody]) {
+        let inputs = inputs_of(points, bodies);
+        plan.plan(&[(0, points.len())], &inputs, points, bodies);
+    }
+
     /// A row of `n` boxes on a fixed floor (body 0), each touching the next: every
     /// manifold coupled, each box on the floor and against its neighbours.
     fn row_on_floor(n: u32) -> (Vec<SoftBody>, Vec<PointConstraint>) {
@@ -1661,12 +1667,7 @@ mod tests {
             points[2 * m].pair_coupling = None;
         }
         let mut plan = PassPlan::default();
-        plan.plan(
-            &[(0, points.len())],
-            &inputs_of(&points, &bodies),
-            &points,
-            &bodies,
-        );
+        plan_one_island(&mut plan, &points, &bodies);
         let mut seen = vec![0; points.len()];
         let mut order = Vec::new();
         for item in &plan.items {
@@ -1720,12 +1721,7 @@ mod tests {
         let kept = plan.items.clone();
         let batched = plan.batches()[0].first_point[3] as usize;
         points[batched].normal_impulse = 0.125;
-        plan.plan(
-            &[(0, points.len())],
-            &inputs_of(&points, &bodies),
-            &points,
-            &bodies,
-        );
+        plan_one_island(&mut plan, &points, &bodies);
         assert_eq!(plan.items, kept);
         assert_eq!(plan.batches()[0].normal_impulses[0].0[3], 0.125);
         // The same, with the manifolds written into their lanes as they are built (as
@@ -1738,12 +1734,7 @@ mod tests {
             let (first, count) = (input.first as usize, input.count() as usize);
             plan.fill_manifold(first, count, &points, &bodies);
         }
-        plan.plan(
-            &[(0, points.len())],
-            &inputs_of(&points, &bodies),
-            &points,
-            &bodies,
-        );
+        plan_one_island(&mut plan, &points, &bodies);
         assert_eq!(plan.items, kept);
         for batch in plan.batches() {
             let mut fresh = *batch;
@@ -1757,19 +1748,9 @@ mod tests {
             assert_eq!(batch.may_bounce, fresh.may_bounce);
         }
         points[batched].pair_coupling = None;
-        plan.plan(
-            &[(0, points.len())],
-            &inputs_of(&points, &bodies),
-            &points,
-            &bodies,
-        );
+        plan_one_island(&mut plan, &points, &bodies);
         let mut fresh = PassPlan::default();
-        fresh.plan(
-            &[(0, points.len())],
-            &inputs_of(&points, &bodies),
-            &points,
-            &bodies,
-        );
+        plan_one_island(&mut fresh, &points, &bodies);
         assert_ne!(plan.items, kept);
         assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
