@@ -5,7 +5,7 @@ use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
 use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon, collide_polygons};
 use crate::math::Vec2;
-use crate::solver::contact::{Contact, restitution_threshold, solve_sequential};
+use crate::solver::contact::{Contact, mixed_friction, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
 use crate::solver::joint::{
     Joint, JointBlockSolver, JointConstraint, JointHandle, JointIterations, JointMotor,
@@ -1486,8 +1486,10 @@ impl World {
             let (Some(a), Some(b)) = (body(m.body_a), body(m.body_b)) else {
                 continue;
             };
-            let friction =
-                (a.friction.unwrap_or(self.friction) * b.friction.unwrap_or(self.friction)).sqrt();
+            let friction = mixed_friction(
+                a.friction.unwrap_or(self.friction),
+                b.friction.unwrap_or(self.friction),
+            );
             let start = &self.scratch.start_velocities;
             let approach = |h: BodyHandle, body: &Body, point: Vec2| {
                 let (v, w) = start
@@ -1497,6 +1499,15 @@ impl World {
                 (v + crate::math::cross_scalar(w, point - body.position)).dot(&m.normal)
             };
             for p in m.points() {
+                let approach_velocity =
+                    approach(m.body_a, a, p.position) - approach(m.body_b, b, p.position);
+                // Without velocities kept from the step's start (the soft step's forces
+                // act inside its substeps), the approach is the velocity now.
+                let normal_velocity = if start.is_empty() {
+                    approach_velocity
+                } else {
+                    (a.velocity_at(p.position) - b.velocity_at(p.position)).dot(&m.normal)
+                };
                 self.contacts.push(Contact {
                     body_a: m.body_a.0,
                     body_b: m.body_b.0,
@@ -1506,10 +1517,8 @@ impl World {
                     id: p.id,
                     restitution: a.restitution.min(b.restitution),
                     friction,
-                    approach_velocity: approach(m.body_a, a, p.position)
-                        - approach(m.body_b, b, p.position),
-                    normal_velocity: (a.velocity_at(p.position) - b.velocity_at(p.position))
-                        .dot(&m.normal),
+                    approach_velocity,
+                    normal_velocity,
                     normal_impulse: 0.0,
                     tangent_impulse: 0.0,
                 });

@@ -108,7 +108,7 @@ impl ManifoldCache {
         while self.last.get(self.cursor).is_some_and(|c| c.pair < pair) {
             self.cursor += 1;
         }
-        let cached = *self.last.get(self.cursor).filter(|c| c.pair == pair)?;
+        let cached = self.last.get(self.cursor).filter(|c| c.pair == pair)?;
         let (offset, turn) = relative_pose(pose_a, pose_b);
         let moved = (offset - cached.relative.0).norm()
             + (turn - cached.relative.1).abs() * pose_a.radius.max(pose_b.radius);
@@ -137,7 +137,7 @@ impl ManifoldCache {
         if manifold.points().is_empty() {
             return None;
         }
-        self.next.push(cached);
+        self.next.push(*cached);
         Some(manifold)
     }
 
