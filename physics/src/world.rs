@@ -247,8 +247,11 @@ struct Scratch {
     fat_pairs: Vec<(u32, u32)>,
     fat_fixed: Vec<bool>,
     solver_bodies: Vec<SolverBody>,
-    /// How far each body can move this step.
+    /// How far each body can move this step, and the two parts of it: its centroid's
+    /// displacement at its current velocity, and how far its spin can carry its
+    /// farthest point.
     reach: Vec<f64>,
+    motion: Vec<(Vec2, f64)>,
     /// Velocities before this step's forces, for restitution.
     start_velocities: Vec<(Vec2, f64)>,
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
@@ -284,6 +287,13 @@ struct Scratch {
     /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
     /// the next contact detection at the same step length: set by `auto` only.
     candidates_current: bool,
+}
+
+/// How far two bodies can close on each other in a step, from each one's `motion`: their
+/// centroids' relative displacement and how far each one's spin carries its farthest point.
+/// No more than the sum of their reaches, and nothing for bodies moving together.
+fn relative_reach((shift_a, turn_a): (Vec2, f64), (shift_b, turn_b): (Vec2, f64)) -> f64 {
+    (shift_a - shift_b).norm() + turn_a + turn_b
 }
 
 impl World {
@@ -1373,13 +1383,19 @@ impl World {
             .resize_with(self.bodies.len(), WorldPolygon::default);
         s.boxes.clear();
         s.reach.clear();
+        s.motion.clear();
         s.poses.clear();
         let margin = self.settings.contact_margin();
         for (body, polygon) in self.bodies.iter().zip(s.polygons.iter_mut()) {
-            let reach = body.as_ref().map_or(0.0, |b| {
-                (b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius()) * dt
+            let (shift, turn) = body.as_ref().map_or((Vec2::zeros(), 0.0), |b| {
+                (
+                    b.velocity * dt,
+                    b.angular_velocity.abs() * b.bounding_radius() * dt,
+                )
             });
+            let reach = shift.norm() + turn;
             s.reach.push(reach);
+            s.motion.push((shift, turn));
             let pose = body.as_ref().map_or(Pose::default(), Pose::of);
             s.poses.push(pose);
             s.boxes.push(body.as_ref().map(|b| {
@@ -1434,8 +1450,11 @@ impl World {
     /// Broad phase, then SAT on each candidate pair (SPEC §3.1), or the pair's last
     /// manifold where it has barely moved (`collide::reuse`).
     ///
-    /// Each body's bounds and contact margin grow by how far it can move this step, so a
-    /// contact is found (as a speculative one) before the bodies meet, however fast.
+    /// Each body's bounds grow by how far it can move this step, and each pair's contact
+    /// margin by how far the two can close on each other (`relative_reach`), so a contact
+    /// is found (as a speculative one) before the bodies meet, however fast. Per body
+    /// (the sum of the two reaches), the smash's debris, flying off together, kept
+    /// ~35,000 speculative manifolds a step that could not touch, of ~51,000.
     fn detect_contacts(&mut self, dt: f64, pipeline: Pipeline) {
         if !std::mem::take(&mut self.scratch.candidates_current) {
             self.find_candidate_pairs(dt);
@@ -1455,7 +1474,7 @@ impl World {
         for &(i, j) in &s.pairs {
             let (a, b) = (BodyHandle(i), BodyHandle(j));
             let (pose_a, pose_b) = (&s.poses[i as usize], &s.poses[j as usize]);
-            let pair_margin = margin + s.reach[i as usize] + s.reach[j as usize];
+            let pair_margin = margin + relative_reach(s.motion[i as usize], s.motion[j as usize]);
             let reused = if self.settings.reuse_manifolds {
                 cache.reuse((a, pose_a), (b, pose_b), pair_margin, reuse_tolerance)
             } else {

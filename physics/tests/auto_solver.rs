@@ -210,14 +210,16 @@ fn auto_conserves_momentum_when_a_small_island_hits_a_big_one() {
         )
         .unwrap();
     let p0 = w.linear_momentum();
-    let mut hit = false;
+    let (mut hit, mut block_solved_soft) = (false, false);
     for step in 0..60 {
         w.step(H);
         let drift = (w.linear_momentum() - p0).norm() / p0.norm();
         assert!(drift < 1e-12, "momentum drift {drift:e} at step {step}");
         hit |= w.body(thrown).unwrap().velocity.x < 39.0;
+        block_solved_soft |= w.island_reports().iter().any(|r| r.contacts > 48);
     }
     assert!(hit, "the box reached the block");
-    // Both solvers ran: the block was solved by the soft step while the box flew alone.
-    assert!(w.island_reports().iter().any(|r| r.contacts > 48));
+    // Both solvers ran: the block was solved by the soft step while the box flew alone
+    // (by the end the debris has scattered into small islands).
+    assert!(block_solved_soft);
 }
