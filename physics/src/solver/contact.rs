@@ -148,7 +148,15 @@ impl Contact {
 /// coefficients (the usual case: both the world's) give that coefficient without a
 /// square root, with the same bits: in binary floating point sqrt(f·f) rounds to f.
 pub fn mixed_friction(a: f64, b: f64) -> f64 {
-    if a == b { a } else { (a * b).sqrt() }
+    if a == b { a } else { geometric_mean(a, b) }
+}
+
+/// Out of line, so that the compiler keeps the branch above: inlined, it computed the
+/// root for every contact and chose after, the stall it was meant to skip.
+#[cold]
+#[inline(never)]
+fn geometric_mean(a: f64, b: f64) -> f64 {
+    (a * b).sqrt()
 }
 
 /// The speed below which contacts do not bounce: resting bodies would otherwise hop on the
