@@ -1566,11 +1566,14 @@ impl World {
             let (a, b) = (motion[m.body_a.index()], motion[m.body_b.index()]);
             -m.depth() - relative_reach(a, b)
         };
+        // A manifold within the margin can close whatever the bodies do: a pile's, and
+        // anything at rest, found without a square root.
+        let within = |m: &Manifold| -m.depth() <= margin;
+        if self.manifolds.iter().all(within) {
+            return;
+        }
         s.gaps.clear();
         s.gaps.extend(self.manifolds.iter().map(gap_after));
-        if s.gaps.iter().all(|&g| g <= margin) {
-            return; // a pile, or anything at rest
-        }
         // How far each body may be turned off its course this step.
         s.turn_off.clear();
         s.turn_off.resize(self.bodies.len(), 0.0);

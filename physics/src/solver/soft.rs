@@ -525,9 +525,13 @@ impl SoftStepSolver {
                 normal_impulse,
                 tangent_impulse,
                 max_normal_impulse: 0.0,
-                closing_acceleration: -(accelerations[c.body_a as usize].0
-                    - accelerations[c.body_b as usize].0)
-                    .dot(&c.normal),
+                // Read only for points that may bounce (`approach`).
+                closing_acceleration: if c.restitution == 0.0 {
+                    0.0
+                } else {
+                    -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
+                        .dot(&c.normal)
+                },
                 in_lcp: false,
                 pair_coupling: None,
             });
