@@ -1391,15 +1391,14 @@ impl World {
         s.poses.clear();
         let margin = self.settings.contact_margin();
         for (body, polygon) in self.bodies.iter().zip(s.polygons.iter_mut()) {
-            let reach = body.as_ref().map_or(0.0, |b| {
-                (b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius()) * dt
-            });
+            // The speed of its farthest point from the spin alone.
+            let spin = body
+                .as_ref()
+                .map_or(0.0, |b| b.angular_velocity.abs() * b.bounding_radius());
+            let velocity = body.as_ref().map_or(Vec2::zeros(), |b| b.velocity);
+            let reach = (velocity.norm() + spin) * dt;
             s.reach.push(reach);
-            s.motion
-                .push(body.as_ref().map_or((Vec2::zeros(), 0.0), |b| {
-                    let turn = b.angular_velocity.abs() * b.bounding_radius();
-                    (b.velocity * dt, turn * dt)
-                }));
+            s.motion.push((velocity * dt, spin * dt));
             let pose = body.as_ref().map_or(Pose::default(), Pose::of);
             s.poses.push(pose);
             s.boxes.push(body.as_ref().map(|b| {
@@ -1577,11 +1576,8 @@ impl World {
         // How far each body may be turned off its course this step.
         s.turn_off.clear();
         s.turn_off.resize(self.bodies.len(), 0.0);
-        for j in self.joints.iter().flatten() {
-            s.turn_off[j.body_a.index()] = f64::INFINITY;
-            if let Some(b) = j.body_b {
-                s.turn_off[b.index()] = f64::INFINITY;
-            }
+        for &i in &self.jointed {
+            s.turn_off[i as usize] = f64::INFINITY;
         }
         for (h, _) in &self.body_motors {
             s.turn_off[h.index()] = f64::INFINITY;
