@@ -1,6 +1,14 @@
 //! The measurement shared by every scene and engine: step a world, time each step alone,
 //! and let the scene look at the state between steps without being timed.
+//!
+//! Engines compared with each other run `interleaved`: each in its own thread, but one at a
+//! time, taking turns of `TURN_STEPS` steps. This machine's speed drifts by tens of
+//! percent over seconds to minutes (other tenants, clocks), so engines run one after the
+//! other saw different machines, and their ratios moved by up to 3× between runs of the
+//! same code; taking turns, every engine sees the same stretches of the machine.
 
+use std::cell::RefCell;
+use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 /// Steps at the start of every run that are simulated but not timed: the first steps
@@ -12,10 +20,15 @@ pub const WARMUP_STEPS: usize = 10;
 /// costs are far below a second, and a run whose steps take seconds cannot spare ten.
 pub const WARMUP_WALL: Duration = Duration::from_secs(1);
 
-/// No new step starts once a run has taken this long (wall time), provided one step has
-/// been timed: pe's dense `exact` solver takes seconds per step on the pyramids, and the
-/// whole benchmark must stay within a few minutes.
+/// No new step starts once a run has had the machine this long (its own turns' wall
+/// time), provided one step has been timed: pe's dense `exact` solver takes seconds per
+/// step on the pyramids, and the whole benchmark must stay within a few minutes.
 pub const RUN_BUDGET: Duration = Duration::from_secs(40);
+
+/// Steps an engine runs before handing the machine to the next one in an `interleaved`
+/// run. The first step of each turn is not timed: the other engines' turns have evicted
+/// its data from the caches, which a run of its own would not have seen.
+pub const TURN_STEPS: usize = 10;
 
 /// The cost of one run's steps.
 #[derive(Debug, Clone, Copy)]
@@ -37,33 +50,159 @@ impl Timing {
 
 /// Runs up to `steps` steps of `world`. Only `step` is inside the clock; `observe` sees the
 /// world after each step (with the number of steps done so far) to record the metric.
+/// Inside an `interleaved` run it hands the machine on every `TURN_STEPS` steps.
 pub fn measure<W>(
     world: &mut W,
     steps: usize,
     mut step: impl FnMut(&mut W),
     mut observe: impl FnMut(&W, usize),
 ) -> Timing {
-    let run_start = Instant::now();
+    // The wall time this run has had the machine: the turns of others do not count.
+    let mut own_before_turn = Duration::ZERO;
+    let mut turn_start = Instant::now();
+    let own = |before: Duration, turn_start: Instant| before + turn_start.elapsed();
     let mut samples = Vec::with_capacity(steps);
     let mut steps_run = 0;
+    let mut first_of_turn = false;
     for n in 0..steps {
-        if !samples.is_empty() && run_start.elapsed() >= RUN_BUDGET {
+        if !samples.is_empty() && own(own_before_turn, turn_start) >= RUN_BUDGET {
             break;
         }
         let start = Instant::now();
         step(world);
         let elapsed = start.elapsed();
-        if n >= WARMUP_STEPS || run_start.elapsed() >= WARMUP_WALL {
+        let warm = n >= WARMUP_STEPS || own(own_before_turn, turn_start) >= WARMUP_WALL;
+        if warm && !first_of_turn {
             samples.push(elapsed);
         }
         observe(world, n + 1);
         steps_run = n + 1;
+        first_of_turn = false;
+        if steps_run % TURN_STEPS == 0 && steps_run < steps && Turns::next_turn() {
+            own_before_turn = own(own_before_turn, turn_start);
+            turn_start = Instant::now();
+            first_of_turn = true;
+        }
     }
     Timing {
         median: median(&mut samples),
         timed_steps: samples.len(),
         steps_run,
         planned: steps,
+    }
+}
+
+/// Runs `jobs` (each a whole run: build the world, `measure`, report) one at a time, in
+/// turns of `TURN_STEPS` steps, and returns their results in order. Each job runs in a
+/// thread of its own, which holds the machine from the start of its turn to the end, so
+/// building a world never overlaps another's timed steps.
+pub fn interleaved<'a, T: Send + 'a>(jobs: Vec<Box<dyn FnOnce() -> T + Send + 'a>>) -> Vec<T> {
+    let turns = Arc::new(Turns::new(jobs.len()));
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = jobs
+            .into_iter()
+            .enumerate()
+            .map(|(me, job)| {
+                let turns = Arc::clone(&turns);
+                std::thread::Builder::new()
+                    // The engines were written for a main thread's stack.
+                    .stack_size(64 << 20)
+                    .spawn_scoped(scope, move || {
+                        pin_to_the_benchmark_core();
+                        turns.wait_for(me);
+                        // Hands the turn on however the job ends, a panic included.
+                        let _done = TurnEnds(&turns, me);
+                        CURRENT_TURN.with(|t| *t.borrow_mut() = Some((Arc::clone(&turns), me)));
+                        job()
+                    })
+                    .expect("a benchmark thread starts")
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    })
+}
+
+/// Keeps the calling thread on one core, the same for every engine's thread: a thread
+/// woken for its turn on the other core would find its data in that core's caches.
+pub fn pin_to_the_benchmark_core() {
+    if let Some(last) = core_affinity::get_core_ids().and_then(|ids| ids.last().copied()) {
+        core_affinity::set_for_current(last);
+    }
+}
+
+thread_local! {
+    /// The turns this thread takes part in, and its place among them (`interleaved`).
+    static CURRENT_TURN: RefCell<Option<(Arc<Turns>, usize)>> = const { RefCell::new(None) };
+}
+
+/// Whose turn it is among the jobs of one `interleaved` run.
+struct Turns {
+    state: Mutex<TurnState>,
+    changed: Condvar,
+}
+
+struct TurnState {
+    current: usize,
+    finished: Vec<bool>,
+}
+
+impl Turns {
+    fn new(jobs: usize) -> Self {
+        Self {
+            state: Mutex::new(TurnState {
+                current: 0,
+                finished: vec![false; jobs],
+            }),
+            changed: Condvar::new(),
+        }
+    }
+
+    fn wait_for(&self, me: usize) {
+        let state = self.state.lock().unwrap_or_else(PoisonError::into_inner);
+        let _mine = self
+            .changed
+            .wait_while(state, |s| s.current != me)
+            .unwrap_or_else(PoisonError::into_inner);
+    }
+
+    /// Gives the machine to the next job that has not finished, and says whether that is
+    /// another job (not `me`).
+    fn pass(&self, me: usize, finished: bool) -> bool {
+        let mut state = self.state.lock().unwrap_or_else(PoisonError::into_inner);
+        state.finished[me] |= finished;
+        let n = state.finished.len();
+        let next = (1..=n).map(|k| (me + k) % n).find(|&j| !state.finished[j]);
+        if let Some(next) = next {
+            state.current = next;
+        }
+        drop(state);
+        self.changed.notify_all();
+        next.is_some_and(|j| j != me)
+    }
+
+    /// Inside an `interleaved` run, lets the other jobs take their turns and returns once
+    /// this thread has the machine again: true if another job ran meanwhile.
+    fn next_turn() -> bool {
+        CURRENT_TURN.with(|t| {
+            let Some((turns, me)) = t.borrow().clone() else {
+                return false;
+            };
+            let handed_on = turns.pass(me, false);
+            turns.wait_for(me);
+            handed_on
+        })
+    }
+}
+
+/// Marks its job finished when dropped, handing the machine on.
+struct TurnEnds<'a>(&'a Turns, usize);
+
+impl Drop for TurnEnds<'_> {
+    fn drop(&mut self) {
+        let _ = self.0.pass(self.1, true);
     }
 }
 
@@ -93,5 +232,49 @@ mod tests {
         assert_eq!(median(&mut [ms(5), ms(1), ms(3)]), ms(3));
         assert_eq!(median(&mut [ms(4), ms(1), ms(2), ms(100)]), ms(3));
         assert_eq!(median(&mut []), Duration::ZERO);
+    }
+
+    /// Jobs take turns of `TURN_STEPS` steps: each step appends its job's number to a
+    /// shared log, which must read in blocks of whole turns, round and round, with no two
+    /// jobs' steps mixed, and every job's results come back in order.
+    #[test]
+    fn interleaved_jobs_take_turns_of_whole_blocks() {
+        let log = Mutex::new(Vec::new());
+        let steps = [25, 10, 32];
+        let jobs: Vec<Box<dyn FnOnce() -> usize + Send + '_>> = steps
+            .iter()
+            .enumerate()
+            .map(|(k, &n)| {
+                let log = &log;
+                Box::new(move || {
+                    let mut count = 0_usize;
+                    let timing = measure(
+                        &mut count,
+                        n,
+                        |c| *c += 1,
+                        |_, _| log.lock().unwrap().push(k),
+                    );
+                    assert_eq!(timing.steps_run, n);
+                    count
+                }) as Box<dyn FnOnce() -> usize + Send + '_>
+            })
+            .collect();
+        assert_eq!(interleaved(jobs), vec![25, 10, 32]);
+        let runs: Vec<(usize, usize)> = log
+            .into_inner()
+            .unwrap()
+            .chunk_by(|a, b| a == b)
+            .map(|c| (c[0], c.len()))
+            .collect();
+        let expected = vec![
+            (0, 10),
+            (1, 10),
+            (2, 10), // the second job finishes with its first turn
+            (0, 10),
+            (2, 10),
+            (0, 5),
+            (2, 12), // the last turn of each: what is left
+        ];
+        assert_eq!(runs, expected);
     }
 }

@@ -14,7 +14,7 @@ mod robots;
 mod scene;
 mod sweep;
 
-use harness::{RUN_BUDGET, Timing, WARMUP_STEPS, WARMUP_WALL};
+use harness::{RUN_BUDGET, TURN_STEPS, Timing, WARMUP_STEPS, WARMUP_WALL, interleaved};
 use pe::ContactSolver;
 use pe_scenes::PeConfig;
 use scene::{H, Metric, PENDULUMS, PYRAMIDS, Pendulum, bounce, chain, joint_grid, smash};
@@ -54,32 +54,35 @@ struct Row {
     peers: Vec<Outcome>,
 }
 
-/// Runs one scene in each pe solver and in each peer, reporting progress on stderr (the
-/// whole benchmark takes a few minutes).
+/// Runs one scene in each pe solver and in each peer, taking turns (`interleaved`), and
+/// reports progress on stderr (the whole benchmark takes a few minutes).
 fn run_row(
     scene: &str,
     known: String,
-    pe_run: impl Fn(ContactSolver) -> Outcome,
-    rapier_run: impl Fn() -> Outcome,
-    box2d_run: impl Fn() -> Outcome,
+    pe_run: impl Fn(ContactSolver) -> Outcome + Sync,
+    rapier_run: impl FnOnce() -> Outcome + Send,
+    box2d_run: impl FnOnce() -> Outcome + Send,
 ) -> Row {
     let started = Instant::now();
-    eprint!("{scene}:");
-    let pe: Vec<Outcome> = PE_SOLVERS
+    eprint!(
+        "{scene}: pe {}, rapier2d, Box2D v3 taking turns…",
+        PE_SOLVERS.map(|s| s.name()).join(", pe ")
+    );
+    let pe_run = &pe_run;
+    let mut jobs: Vec<Job<'_>> = PE_SOLVERS
         .iter()
-        .map(|&s| {
-            eprint!(" pe {}…", s.name());
-            pe_run(s)
-        })
+        .map(|&s| Box::new(move || pe_run(s)) as Job<'_>)
         .collect();
-    eprint!(" rapier2d…");
-    let rapier = rapier_run();
-    eprint!(" Box2D…");
-    let box2d = box2d_run();
+    jobs.push(Box::new(rapier_run));
+    jobs.push(Box::new(box2d_run));
+    let mut pe = interleaved(jobs);
+    let peers = pe.split_off(PE_SOLVERS.len());
     eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
     let names = PE_SOLVERS.iter().map(|s| format!("pe {}", s.name()));
-    let all = pe.iter().chain([&rapier, &box2d]);
-    for (name, o) in names.chain(PEERS.map(String::from)).zip(all) {
+    for (name, o) in names
+        .chain(PEERS.map(String::from))
+        .zip(pe.iter().chain(&peers))
+    {
         if o.timing.cut_short() {
             eprintln!(
                 "  ({name} stopped after {} steps: budget)",
@@ -91,13 +94,17 @@ fn run_row(
         scene: scene.to_string(),
         known,
         pe,
-        peers: vec![rapier, box2d],
+        peers,
     }
 }
+
+/// One engine's whole run of a scene, for `interleaved`.
+type Job<'a> = Box<dyn FnOnce() -> Outcome + Send + 'a>;
 
 fn main() {
     let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench");
     let load = load_average();
+    harness::pin_to_the_benchmark_core();
     let started = Instant::now();
     if std::env::args().nth(1).as_deref() == Some("sweep") {
         let mut md = sweep::run(docs);
@@ -204,9 +211,8 @@ fn run_pe_alone() {
 }
 
 /// `pile <scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile (or the joint grid,
-/// or the smash), taking turns for a few rounds so that all three see the machine in the
-/// same states, printing each round's medians and the ratios (a quick check while working
-/// on the soft step).
+/// or the smash), taking turns (`interleaved`), for a few rounds, printing each round's
+/// medians and the ratios (a quick check while working on the soft step).
 fn run_pile_with_peers() {
     let scene = std::env::args()
         .nth(2)
@@ -216,35 +222,37 @@ fn run_pile_with_peers() {
         .and_then(|r| r.parse().ok())
         .unwrap_or(3);
     let pe = PeConfig::new(ContactSolver::Soft);
-    type Run = Box<dyn Fn() -> Outcome>;
-    let (pe_run, rapier_run, box2d_run): (Run, Run, Run) =
-        if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
-            (
+    let pyramid = PYRAMIDS.iter().find(|p| p.name == scene);
+    let jobs = || -> Vec<Job<'static>> {
+        if let Some(spec) = pyramid {
+            vec![
                 Box::new(move || pe_scenes::pyramid(pe, spec, H)),
                 Box::new(move || rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS)),
                 Box::new(move || box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS)),
-            )
+            ]
         } else if scene == joint_grid::NAME {
-            (
+            vec![
                 Box::new(move || pe_scenes::joint_grid(pe)),
                 Box::new(rapier_scenes::joint_grid),
                 Box::new(box2d_scenes::joint_grid),
-            )
+            ]
         } else if scene == smash::NAME {
-            (
+            vec![
                 Box::new(move || pe_scenes::smash(pe)),
                 Box::new(rapier_scenes::smash),
                 Box::new(box2d_scenes::smash),
-            )
+            ]
         } else {
             let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
             names.extend([joint_grid::NAME, smash::NAME]);
             eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
             std::process::exit(2);
-        };
+        }
+    };
     let mut ratios = Vec::with_capacity(rounds);
     for round in 1..=rounds {
-        let (pe, rapier, box2d) = (pe_run(), rapier_run(), box2d_run());
+        let [pe, rapier, box2d] =
+            <[Outcome; 3]>::try_from(interleaved(jobs())).expect("three engines");
         let of = |peer: &Outcome| pe.timing.median.as_secs_f64() / peer.timing.median.as_secs_f64();
         ratios.push((of(&rapier), of(&box2d)));
         println!(
@@ -288,8 +296,8 @@ fn write_doc(docs: &str, file: &str, md: &str) {
 }
 
 /// pe soft with the narrow phase's manifold reuse on and off, on the scenes of many
-/// resting contacts, run back to back so that both see the machine in the same state (the
-/// main table's run was minutes earlier, and times drift by tens of percent across a run).
+/// resting contacts, taking turns (`interleaved`) so that both see the machine in the
+/// same states.
 struct NarrowRow {
     scene: String,
     reuse: Outcome,
@@ -302,21 +310,24 @@ fn narrow_phase_rows() -> Vec<NarrowRow> {
         reuse_manifolds: false,
         ..reuse
     };
-    let mut out = Vec::new();
-    for spec in &PYRAMIDS {
-        eprintln!("{}: pe soft with and without manifold reuse…", spec.name);
-        out.push(NarrowRow {
-            scene: spec.name.to_string(),
-            reuse: pe_scenes::pyramid(reuse, spec, H),
-            fresh: pe_scenes::pyramid(fresh, spec, H),
-        });
-    }
-    eprintln!("{}: pe soft with and without manifold reuse…", smash::NAME);
-    out.push(NarrowRow {
-        scene: smash::NAME.to_string(),
-        reuse: pe_scenes::smash(reuse),
-        fresh: pe_scenes::smash(fresh),
-    });
+    let both = |scene: &str, run: &(dyn Fn(PeConfig) -> Outcome + Sync)| {
+        eprintln!("{scene}: pe soft with and without manifold reuse, taking turns…");
+        let [reuse, fresh] = <[Outcome; 2]>::try_from(interleaved(vec![
+            Box::new(move || run(reuse)) as Job<'_>,
+            Box::new(move || run(fresh)),
+        ]))
+        .expect("two runs");
+        NarrowRow {
+            scene: scene.to_string(),
+            reuse,
+            fresh,
+        }
+    };
+    let mut out: Vec<NarrowRow> = PYRAMIDS
+        .iter()
+        .map(|spec| both(spec.name, &|c| pe_scenes::pyramid(c, spec, H)))
+        .collect();
+    out.push(both(smash::NAME, &pe_scenes::smash));
     out
 }
 
@@ -393,16 +404,19 @@ fn report(
     );
     let _ = writeln!(
         w,
-        "- Timing: each step timed alone with `std::time::Instant`; the first \
+        "- Timing: the engines of a scene take turns of {TURN_STEPS} steps (each in its \
+         own thread, one running at a time), so that all of them see the machine in the \
+         same states; each step is timed alone with `std::time::Instant`; the first \
          {WARMUP_STEPS} steps of a run are a warm-up, simulated but not timed (only those \
-         ending within the run's first {} s, so a run of multi-second steps is timed from \
-         its first step); the figure is the median of the timed steps (mean of the middle \
-         two for an even count). Release build.",
+         ending within the run's first {} s of turns, so a run of multi-second steps is \
+         timed from its first step), and neither is the first step of each later turn \
+         (the other engines' turns have emptied the caches); the figure is the median of \
+         the timed steps (mean of the middle two for an even count). Release build.",
         WARMUP_WALL.as_secs()
     );
     let _ = writeln!(
         w,
-        "- Budget: a run starts no new step after {} s of wall time once one step is timed; \
+        "- Budget: a run starts no new step after {} s of its own turns once one step is timed; \
          runs cut short are marked †, and their metric covers only the steps run.",
         RUN_BUDGET.as_secs()
     );
@@ -476,7 +490,7 @@ fn report(
         "A pair whose relative pose has moved less than a tenth of the slop since its \
          manifold was found keeps that manifold's features (recomputed at the current \
          poses) instead of a new separating-axis test; `fresh` tests every pair every step. \
-         The two runs of a scene are back to back.\n"
+         The two runs of a scene take turns.\n"
     );
     let columns: Vec<String> = [
         "reuse: time per step",
