@@ -8,6 +8,7 @@
 //! same code; taking turns, every engine sees the same stretches of the machine.
 
 use std::cell::RefCell;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -24,6 +25,16 @@ pub const WARMUP_WALL: Duration = Duration::from_secs(1);
 /// time), provided one step has been timed: pe's dense `exact` solver takes seconds per
 /// step on the pyramids, and the whole benchmark must stay within a few minutes.
 pub const RUN_BUDGET: Duration = Duration::from_secs(40);
+
+/// `fixed_steps`' count, 0 when unset.
+static FIXED_STEPS: AtomicUsize = AtomicUsize::new(0);
+
+/// Makes every later run exactly `steps` steps long, whatever its scene plans and
+/// whatever the time it takes: for counting instructions under a profiler (callgrind),
+/// where the budget would cut runs of two builds at different steps.
+pub fn fixed_steps(steps: usize) {
+    FIXED_STEPS.store(steps, Ordering::Relaxed);
+}
 
 /// Steps an engine runs before handing the machine to the next one in an `interleaved`
 /// run. The first step of each turn is not timed: the other engines' turns have evicted
@@ -57,6 +68,12 @@ pub fn measure<W>(
     mut step: impl FnMut(&mut W),
     mut observe: impl FnMut(&W, usize),
 ) -> Timing {
+    let fixed = FIXED_STEPS.load(Ordering::Relaxed);
+    let (steps, budget) = if fixed > 0 {
+        (fixed, Duration::MAX)
+    } else {
+        (steps, RUN_BUDGET)
+    };
     // The wall time this run has had the machine: the turns of others do not count.
     let mut own_before_turn = Duration::ZERO;
     let mut turn_start = Instant::now();
@@ -65,7 +82,7 @@ pub fn measure<W>(
     let mut steps_run = 0;
     let mut first_of_turn = false;
     for n in 0..steps {
-        if !samples.is_empty() && own(own_before_turn, turn_start) >= RUN_BUDGET {
+        if !samples.is_empty() && own(own_before_turn, turn_start) >= budget {
             break;
         }
         let start = Instant::now();

@@ -179,9 +179,10 @@ fn main() {
     write_doc(docs, "results.md", &report);
 }
 
-/// `pe <scene> [solver] [fresh] [forwards]`: one pile, grid or smash scene in pe alone, so
-/// that a profiler sees only pe's step (`fresh`: no manifold reuse; `forwards`: the soft
-/// step sweeps its colours in one order only).
+/// `pe <scene> [solver] [fresh] [forwards] [steps=N]`: one pile, grid or smash scene in pe
+/// alone, so that a profiler sees only pe's step (`fresh`: no manifold reuse; `forwards`:
+/// the soft step sweeps its colours in one order only; `steps=N`: exactly N steps, with no
+/// time budget, so that two builds' instruction counts compare).
 fn run_pe_alone() {
     let scene = std::env::args().nth(2).unwrap_or_default();
     let solver_name = std::env::args().nth(3).unwrap_or_else(|| "soft".into());
@@ -190,6 +191,12 @@ fn run_pe_alone() {
         std::process::exit(2);
     };
     let flags: Vec<String> = std::env::args().skip(4).collect();
+    if let Some(steps) = flags
+        .iter()
+        .find_map(|f| f.strip_prefix("steps=")?.parse().ok())
+    {
+        harness::fixed_steps(steps);
+    }
     let config = PeConfig {
         reuse_manifolds: !flags.iter().any(|f| f == "fresh"),
         soft_alternating_sweeps: !flags.iter().any(|f| f == "forwards"),
