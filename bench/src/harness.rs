@@ -74,31 +74,28 @@ pub fn measure<W>(
     } else {
         (steps, RUN_BUDGET)
     };
-    // The wall time this run has had the machine: the turns of others do not count.
-    let mut own_before_turn = Duration::ZERO;
-    let mut turn_start = Instant::now();
-    let own = |before: Duration, turn_start: Instant| before + turn_start.elapsed();
+    let mut clock = OwnClock::start();
     let mut samples = Vec::with_capacity(steps);
     let mut steps_run = 0;
     let mut first_of_turn = false;
     for n in 0..steps {
-        if !samples.is_empty() && own(own_before_turn, turn_start) >= budget {
+        if !samples.is_empty() && clock.elapsed() >= budget {
             break;
         }
         let start = Instant::now();
         step(world);
         let elapsed = start.elapsed();
-        let warm = n >= WARMUP_STEPS || own(own_before_turn, turn_start) >= WARMUP_WALL;
+        let warm = n >= WARMUP_STEPS || clock.elapsed() >= WARMUP_WALL;
         if warm && !first_of_turn {
             samples.push(elapsed);
         }
         observe(world, n + 1);
         steps_run = n + 1;
         first_of_turn = false;
-        if steps_run % TURN_STEPS == 0 && steps_run < steps && Turns::next_turn() {
-            own_before_turn = own(own_before_turn, turn_start);
-            turn_start = Instant::now();
-            first_of_turn = true;
+        if steps_run % TURN_STEPS == 0 && steps_run < steps {
+            clock.pause();
+            first_of_turn = Turns::next_turn();
+            clock.resume();
         }
     }
     Timing {
@@ -106,6 +103,35 @@ pub fn measure<W>(
         timed_steps: samples.len(),
         steps_run,
         planned: steps,
+    }
+}
+
+/// The wall time a run has had the machine: the other jobs' turns do not count.
+struct OwnClock {
+    before: Duration,
+    since: Option<Instant>,
+}
+
+impl OwnClock {
+    fn start() -> Self {
+        Self {
+            before: Duration::ZERO,
+            since: Some(Instant::now()),
+        }
+    }
+
+    fn pause(&mut self) {
+        if let Some(since) = self.since.take() {
+            self.before += since.elapsed();
+        }
+    }
+
+    fn resume(&mut self) {
+        self.since.get_or_insert_with(Instant::now);
+    }
+
+    fn elapsed(&self) -> Duration {
+        self.before + self.since.map_or(Duration::ZERO, |s| s.elapsed())
     }
 }
 
@@ -249,6 +275,21 @@ mod tests {
         assert_eq!(median(&mut [ms(5), ms(1), ms(3)]), ms(3));
         assert_eq!(median(&mut [ms(4), ms(1), ms(2), ms(100)]), ms(3));
         assert_eq!(median(&mut []), Duration::ZERO);
+    }
+
+    #[test]
+    fn a_runs_own_clock_stops_while_it_waits() {
+        let mut clock = OwnClock::start();
+        std::thread::sleep(Duration::from_millis(20));
+        clock.pause();
+        std::thread::sleep(Duration::from_millis(100));
+        let paused = clock.elapsed();
+        clock.resume();
+        std::thread::sleep(Duration::from_millis(20));
+        let resumed = clock.elapsed();
+        // Sleeps last at least as long as asked; 100 ms of slack for a busy machine.
+        assert!(paused >= Duration::from_millis(20) && paused < Duration::from_millis(100));
+        assert!(resumed >= Duration::from_millis(40) && resumed < Duration::from_millis(120));
     }
 
     /// Jobs take turns of `TURN_STEPS` steps: each step appends its job's number to a
