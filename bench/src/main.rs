@@ -173,9 +173,17 @@ fn main() {
         rapier_scenes::smash,
         box2d_scenes::smash,
     ));
+    let piles = pile_rows();
     let narrow = narrow_phase_rows();
     let robot_rows = robots::run();
-    let report = report(&rows, &narrow, &robot_rows, started.elapsed(), &load);
+    let report = report(
+        &rows,
+        &piles,
+        &narrow,
+        &robot_rows,
+        started.elapsed(),
+        &load,
+    );
     write_doc(docs, "results.md", &report);
 }
 
@@ -217,6 +225,70 @@ fn run_pe_alone() {
     println!("{scene} under pe {}: {outcome:?}", solver.name());
 }
 
+/// The scenes of `pile`: every pile, the joint grid and the smash.
+fn pile_scenes() -> Vec<&'static str> {
+    let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
+    names.extend([joint_grid::NAME, smash::NAME]);
+    names
+}
+
+/// pe `soft`, rapier2d and Box2D v3 on one of `pile_scenes`, in that order, as jobs for
+/// `interleaved`; `None` for another scene.
+fn pile_jobs(scene: &str) -> Option<Vec<Job<'static>>> {
+    let pe = PeConfig::new(ContactSolver::Soft);
+    if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
+        Some(vec![
+            Box::new(move || pe_scenes::pyramid(pe, spec, H)),
+            Box::new(move || rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS)),
+            Box::new(move || box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS)),
+        ])
+    } else if scene == joint_grid::NAME {
+        Some(vec![
+            Box::new(move || pe_scenes::joint_grid(pe)),
+            Box::new(rapier_scenes::joint_grid),
+            Box::new(box2d_scenes::joint_grid),
+        ])
+    } else if scene == smash::NAME {
+        Some(vec![
+            Box::new(move || pe_scenes::smash(pe)),
+            Box::new(rapier_scenes::smash),
+            Box::new(box2d_scenes::smash),
+        ])
+    } else {
+        None
+    }
+}
+
+/// One round of `pile_jobs`: pe soft, rapier2d and Box2D v3 taking turns.
+struct PileRound {
+    pe: Outcome,
+    rapier: Outcome,
+    box2d: Outcome,
+}
+
+impl PileRound {
+    fn run(scene: &str) -> Option<Self> {
+        let [pe, rapier, box2d] =
+            <[Outcome; 3]>::try_from(interleaved(pile_jobs(scene)?)).expect("three engines");
+        Some(Self { pe, rapier, box2d })
+    }
+
+    /// pe's median over rapier2d's and over Box2D v3's.
+    fn ratios(&self) -> (f64, f64) {
+        let of =
+            |peer: &Outcome| self.pe.timing.median.as_secs_f64() / peer.timing.median.as_secs_f64();
+        (of(&self.rapier), of(&self.box2d))
+    }
+}
+
+/// The smallest and largest of some ratios, as "lo–hi".
+fn ratio_range(ratios: impl Iterator<Item = f64>) -> String {
+    let (lo, hi) = ratios.fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| {
+        (lo.min(r), hi.max(r))
+    });
+    format!("{lo:.2}–{hi:.2}")
+}
+
 /// `pile <scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile (or the joint grid,
 /// or the smash), taking turns (`interleaved`), for a few rounds, printing each round's
 /// medians and the ratios (a quick check while working on the soft step).
@@ -228,67 +300,50 @@ fn run_pile_with_peers() {
         .nth(3)
         .and_then(|r| r.parse().ok())
         .unwrap_or(3);
-    let pe = PeConfig::new(ContactSolver::Soft);
-    let pyramid = PYRAMIDS.iter().find(|p| p.name == scene);
-    let jobs = || -> Vec<Job<'static>> {
-        if let Some(spec) = pyramid {
-            vec![
-                Box::new(move || pe_scenes::pyramid(pe, spec, H)),
-                Box::new(move || rapier_scenes::pyramid(spec, H, rapier_scenes::ITERATIONS)),
-                Box::new(move || box2d_scenes::pyramid(spec, H, box2d_scenes::SUBSTEPS)),
-            ]
-        } else if scene == joint_grid::NAME {
-            vec![
-                Box::new(move || pe_scenes::joint_grid(pe)),
-                Box::new(rapier_scenes::joint_grid),
-                Box::new(box2d_scenes::joint_grid),
-            ]
-        } else if scene == smash::NAME {
-            vec![
-                Box::new(move || pe_scenes::smash(pe)),
-                Box::new(rapier_scenes::smash),
-                Box::new(box2d_scenes::smash),
-            ]
-        } else {
-            let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
-            names.extend([joint_grid::NAME, smash::NAME]);
-            eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
-            std::process::exit(2);
-        }
-    };
-    let mut ratios = Vec::with_capacity(rounds);
+    let mut done = Vec::with_capacity(rounds);
     for round in 1..=rounds {
-        let [pe, rapier, box2d] =
-            <[Outcome; 3]>::try_from(interleaved(jobs())).expect("three engines");
-        let of = |peer: &Outcome| pe.timing.median.as_secs_f64() / peer.timing.median.as_secs_f64();
-        ratios.push((of(&rapier), of(&box2d)));
+        let Some(r) = PileRound::run(&scene) else {
+            eprintln!(
+                "unknown scene {scene:?}: one of {}",
+                pile_scenes().join(", ")
+            );
+            std::process::exit(2);
+        };
+        let (to_rapier, to_box2d) = r.ratios();
         println!(
             "{scene} round {round}: pe soft {} ({}), rapier2d {} ({}), Box2D v3 {} ({}); \
-             pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
-            pretty(pe.timing.median),
-            pe.metric,
-            pretty(rapier.timing.median),
-            rapier.metric,
-            pretty(box2d.timing.median),
-            box2d.metric,
-            ratio(pe.timing.median, rapier.timing.median),
-            ratio(pe.timing.median, box2d.timing.median),
+             pe ÷ rapier2d {to_rapier:.2}, pe ÷ Box2D v3 {to_box2d:.2}",
+            pretty(r.pe.timing.median),
+            r.pe.metric,
+            pretty(r.rapier.timing.median),
+            r.rapier.metric,
+            pretty(r.box2d.timing.median),
+            r.box2d.metric,
         );
+        done.push(r);
     }
-    let range = |pick: fn(&(f64, f64)) -> f64| {
-        let (lo, hi) = ratios
-            .iter()
-            .map(pick)
-            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| {
-                (lo.min(r), hi.max(r))
-            });
-        format!("{lo:.2}–{hi:.2}")
-    };
     println!(
         "{scene} over {rounds} rounds: pe ÷ rapier2d {}, pe ÷ Box2D v3 {}",
-        range(|r| r.0),
-        range(|r| r.1)
+        ratio_range(done.iter().map(|r| r.ratios().0)),
+        ratio_range(done.iter().map(|r| r.ratios().1))
     );
+}
+
+/// The main run's closing rounds: pe `soft` and the two peers alone on each of
+/// `pile_scenes`, `PILE_ROUNDS` times.
+const PILE_ROUNDS: usize = 3;
+
+fn pile_rows() -> Vec<(&'static str, Vec<PileRound>)> {
+    pile_scenes()
+        .into_iter()
+        .map(|scene| {
+            eprintln!("{scene}: pe soft, rapier2d, Box2D v3 taking turns, {PILE_ROUNDS} rounds…");
+            let rounds = (0..PILE_ROUNDS)
+                .map(|_| PileRound::run(scene).expect("a pile scene"))
+                .collect();
+            (scene, rounds)
+        })
+        .collect()
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
@@ -385,6 +440,7 @@ fn ratio(pe: Duration, peer: Duration) -> String {
 
 fn report(
     rows: &[Row],
+    piles: &[(&str, Vec<PileRound>)],
     narrow: &[NarrowRow],
     robot_rows: &[robots::RobotRow],
     elapsed: Duration,
@@ -490,6 +546,41 @@ fn report(
          — the largest drift of the total linear momentum from its start (no gravity, no \
          static body: it is conserved exactly), and the kinetic energy left at the end."
     );
+
+    let _ = writeln!(
+        w,
+        "\n## pe soft and the peers alone, {PILE_ROUNDS} rounds\n"
+    );
+    let _ = writeln!(
+        w,
+        "The table above takes five engines' turns, pe `exact`'s and `auto`'s among them. \
+         Here pe `soft`, rapier2d and Box2D v3 take turns alone on the big scenes, {PILE_ROUNDS} \
+         times over (`cargo run --release -- pile <scene>`): each round's medians, then the \
+         range of the ratios over the rounds.\n"
+    );
+    let columns: Vec<String> = (1..=PILE_ROUNDS)
+        .map(|k| format!("round {k}: pe soft / rapier2d / Box2D v3"))
+        .chain(["pe soft ÷ rapier2d".into(), "pe soft ÷ Box2D v3".into()])
+        .collect();
+    let _ = writeln!(w, "{}", table_head(&["scene"], &columns, "---:"));
+    for (scene, rounds) in piles {
+        let _ = write!(w, "| {scene} |");
+        for r in rounds {
+            let _ = write!(
+                w,
+                " {} / {} / {} |",
+                time_cell(&r.pe.timing),
+                time_cell(&r.rapier.timing),
+                time_cell(&r.box2d.timing)
+            );
+        }
+        let _ = writeln!(
+            w,
+            " {} | {} |",
+            ratio_range(rounds.iter().map(|r| r.ratios().0)),
+            ratio_range(rounds.iter().map(|r| r.ratios().1))
+        );
+    }
 
     let _ = writeln!(w, "\n## Narrow phase: manifold reuse (pe soft)\n");
     let _ = writeln!(
