@@ -473,7 +473,7 @@ fn report(
          {WARMUP_STEPS} steps of a run are a warm-up, simulated but not timed (only those \
          ending within the run's first {} s of turns, so a run of multi-second steps is \
          timed from its first step), and neither is the first step of each later turn \
-         (the other engines' turns have emptied the caches); the figure is the median of \
+         (the other engines' turns may have emptied the caches); the figure is the median of \
          the timed steps (mean of the middle two for an even count). Release build.",
         WARMUP_WALL.as_secs()
     );
