@@ -217,9 +217,10 @@ fn run_pe_alone() {
     } else if scene == smash::NAME {
         pe_scenes::smash(config)
     } else {
-        let mut names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
-        names.extend([joint_grid::NAME, smash::NAME]);
-        eprintln!("unknown scene {scene:?}: one of {}", names.join(", "));
+        eprintln!(
+            "unknown scene {scene:?}: one of {}",
+            pile_scenes().join(", ")
+        );
         std::process::exit(2);
     };
     println!("{scene} under pe {}: {outcome:?}", solver.name());
@@ -275,8 +276,7 @@ impl PileRound {
 
     /// pe's median over rapier2d's and over Box2D v3's.
     fn ratios(&self) -> (f64, f64) {
-        let of =
-            |peer: &Outcome| self.pe.timing.median.as_secs_f64() / peer.timing.median.as_secs_f64();
+        let of = |peer: &Outcome| time_ratio(self.pe.timing.median, peer.timing.median);
         (of(&self.rapier), of(&self.box2d))
     }
 }
@@ -429,8 +429,13 @@ fn metric_cell(o: &Outcome) -> String {
     }
 }
 
+/// pe's time over a peer's.
+fn time_ratio(pe: Duration, peer: Duration) -> f64 {
+    pe.as_secs_f64() / peer.as_secs_f64()
+}
+
 fn ratio(pe: Duration, peer: Duration) -> String {
-    let r = pe.as_secs_f64() / peer.as_secs_f64();
+    let r = time_ratio(pe, peer);
     if r < 100.0 {
         format!("{r:.2}")
     } else {
