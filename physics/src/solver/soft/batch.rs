@@ -46,6 +46,42 @@ const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 /// fewer).
 const MIN_COLOURED_ISLAND: usize = 48;
 
+/// How many manifolds ahead of the one batched now `plan` asks the cache for the points
+/// and bodies of.
+const PREFETCH_AHEAD: usize = 16;
+
+/// A manifold of a coloured island, as `plan` sorts them.
+#[derive(Debug, Clone, Copy)]
+struct ColouredManifold {
+    /// 2 × colour, + 1 if sideways (`PlanInput::SIDEWAYS`): the sort's key.
+    key: u32,
+    first: u32,
+    count: u32,
+    bodies: (u32, u32),
+}
+
+/// Asks the cache for the lines holding `values`, ahead of reading them.
+#[inline(always)]
+fn prefetch<T>(values: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        const LINE: usize = 64;
+        let start = values.as_ptr().cast::<i8>();
+        // From the start of the line `values` begins in, up to the one it ends in.
+        let skew = start as usize % LINE;
+        for offset in (0..skew + std::mem::size_of_val(values)).step_by(LINE) {
+            // A prefetch is only a hint: it reads nothing the program sees and cannot
+            // fault, so the address needs no more than to be computed without overflow.
+            let line = start.wrapping_sub(skew).wrapping_add(offset);
+            // SAFETY: as above, a prefetch of any address is sound.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line) };
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = values;
+}
+
 /// One step of the passes' work, in order: a batch of eight two-point manifolds, a batch
 /// of eight one-point ones, or one manifold (`(first point, point count)`) solved alone.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,11 +103,11 @@ pub(super) struct PassPlan {
     singles: BatchPool<1>,
     /// Per body, a bit for each colour it already has a manifold in.
     colours_of: Vec<u32>,
-    /// `(2 × colour + 1 if sideways, first point, point count)` of the coloured manifolds.
-    coloured: Vec<(u32, u32, u32)>,
+    /// The coloured manifolds, by `ColouredManifold::key`.
+    coloured: Vec<ColouredManifold>,
     /// The counting sort of `coloured` by colour: its output, and where each colour
     /// starts in it.
-    by_colour: Vec<(u32, u32, u32)>,
+    by_colour: Vec<ColouredManifold>,
     colour_starts: Vec<u32>,
     /// The coloured manifolds (indices into `inputs`) in the order they are coloured
     /// (`colour_in_scattered_order`), its counting sort's scratch and buckets, and each
@@ -209,7 +245,12 @@ impl PassPlan {
                 // The sort key below: the colour, then sideways after upright.
                 let sideways = u32::from(input.flags & PlanInput::SIDEWAYS != 0);
                 let key = 2 * self.colour_by_input[k] + sideways;
-                self.coloured.push((key, input.first, input.count()));
+                self.coloured.push(ColouredManifold {
+                    key,
+                    first: input.first,
+                    count: input.count(),
+                    bodies: (input.a, input.b),
+                });
             } else {
                 self.items
                     .push(PassItem::Manifold(input.first, input.count()));
@@ -224,7 +265,7 @@ impl PassPlan {
         // fewer batches hold a manifold whose two points part (one touching, one not),
         // which takes the slower path (`solve_normals_together`): on the 40-row pyramid
         // at rest 332 of 2,400 batch passes a step, against 504 ungrouped.
-        let key = |&(key, _, _): &(u32, u32, u32)| key as usize;
+        let key = |m: &ColouredManifold| m.key as usize;
         let keys = 2 * COLOURS as usize; // colours 0..COLOURS (`colour_of`), two ways
         counting_sort(
             &self.coloured,
@@ -237,11 +278,18 @@ impl PassPlan {
         // Two-point and one-point manifolds fill their own batches, colour by colour.
         let pad_from = LanePath::best().fewest_padded();
         let mut i = 0;
-        let colour_at = |coloured: &[(u32, u32, u32)], i: usize| coloured[i].0 / 2;
+        let colour_at = |coloured: &[ColouredManifold], i: usize| coloured[i].key / 2;
         while i < self.coloured.len() {
             let colour = colour_at(&self.coloured, i);
             while i < self.coloured.len() && colour_at(&self.coloured, i) == colour {
-                let (_, first, count) = self.coloured[i];
+                let ColouredManifold { first, count, .. } = self.coloured[i];
+                // Filling reads the points in colour order, scattered over the step's
+                // points (the smash's ~12 MB): they are asked for ahead.
+                if let Some(ahead) = self.coloured.get(i + PREFETCH_AHEAD) {
+                    prefetch(&points[ahead.first as usize..][..ahead.count as usize]);
+                    prefetch(std::slice::from_ref(&bodies[ahead.bodies.0 as usize]));
+                    prefetch(std::slice::from_ref(&bodies[ahead.bodies.1 as usize]));
+                }
                 i += 1;
                 let items = &mut self.items;
                 match (colour, count) {
