@@ -7,8 +7,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, PeerBody, Pendulum, PeriodTracker,
-    Pyramid, PyramidTracker, ReboundTracker, bounce, chain, joint_grid,
+    BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, PeerBody, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid,
     momentum_and_kinetic_energy, smash, worst,
 };
 use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
@@ -242,6 +242,15 @@ pub fn bounce(h: f64, substeps: i32) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
+/// The smash's boxes' poses, in the scene's order.
+fn smash_poses<'a>(world: &'a World, bodies: &'a [BodyId]) -> impl Iterator<Item = BoxPose> + 'a {
+    bodies.iter().enumerate().map(move |(i, &b)| {
+        let r = world.body_rotation(b);
+        let angle = f64::from(r.sine()).atan2(f64::from(r.cosine()));
+        smash::box_pose(i, centre(world, b), angle)
+    })
+}
+
 pub fn smash() -> Outcome {
     let def = WorldDef::builder()
         .gravity([0.0, 0.0])
@@ -266,14 +275,14 @@ pub fn smash() -> Outcome {
     bodies.push(heavy);
     let totals = |w: &World| momentum_and_kinetic_energy(bodies.iter().map(|&b| motion(w, b)));
     let (p0, e0) = totals(&w);
-    let mut tracker = MomentumTracker::new(p0, e0);
+    let mut tracker = SmashTracker::new(p0, e0);
     let timing = measure(
         &mut w,
         smash::STEPS,
         |w| step(w, H, SUBSTEPS),
         |w, _| {
             let (p, e) = totals(w);
-            tracker.update(p, e);
+            tracker.update(p, e, smash_poses(w, &bodies));
         },
     );
     Outcome::new(timing, tracker.finish())

@@ -4,8 +4,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, Pendulum, PeriodTracker, Pyramid,
-    PyramidTracker, ReboundTracker, bounce, chain, joint_grid, smash, worst,
+    BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid, smash, worst,
 };
 use pe::{
     BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle,
@@ -177,6 +177,15 @@ pub fn bounce(config: PeConfig, h: f64) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
+/// The smash's boxes' poses, in the scene's order. The scene's y points up, pe's down:
+/// mirrored, a box turns the other way.
+fn smash_poses(world: &World) -> impl Iterator<Item = BoxPose> + '_ {
+    let pose = |(i, (_, b)): (usize, (BodyHandle, &pe::Body))| {
+        smash::box_pose(i, (b.position.x, -b.position.y), -b.angle)
+    };
+    world.bodies().enumerate().map(pose)
+}
+
 pub fn smash(config: PeConfig) -> Outcome {
     let mut w = world(config);
     w.gravity = Vec2::zeros();
@@ -193,12 +202,12 @@ pub fn smash(config: PeConfig) -> Outcome {
         let p = w.linear_momentum();
         (p.x, -p.y)
     };
-    let mut tracker = MomentumTracker::new(momentum(&w), w.kinetic_energy());
+    let mut tracker = SmashTracker::new(momentum(&w), w.kinetic_energy());
     let timing = measure(
         &mut w,
         smash::STEPS,
         |w| w.step(H),
-        |w, _| tracker.update(momentum(w), w.kinetic_energy()),
+        |w, _| tracker.update(momentum(w), w.kinetic_energy(), smash_poses(w)),
     );
     Outcome::new(timing, tracker.finish())
 }

@@ -5,8 +5,8 @@
 use crate::Outcome;
 use crate::harness::measure;
 use crate::scene::{
-    BOB, BOX, FLOOR, FRICTION, G, H, Metric, MomentumTracker, PeerBody, Pendulum, PeriodTracker,
-    Pyramid, PyramidTracker, ReboundTracker, bounce, chain, joint_grid,
+    BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, PeerBody, Pendulum, PeriodTracker, Pyramid,
+    PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid,
     momentum_and_kinetic_energy, smash, worst,
 };
 use rapier2d::prelude::*;
@@ -185,6 +185,17 @@ pub fn bounce(h: f64, iterations: usize) -> Outcome {
     Outcome::new(timing, tracker.finish())
 }
 
+/// The smash's boxes' poses, in the scene's order.
+fn smash_poses<'a>(
+    world: &'a PhysicsWorld,
+    bodies: &'a [RigidBodyHandle],
+) -> impl Iterator<Item = BoxPose> + 'a {
+    bodies.iter().enumerate().map(move |(i, &b)| {
+        let angle = f64::from(world.bodies[b].rotation().angle());
+        smash::box_pose(i, centre(world, b), angle)
+    })
+}
+
 pub fn smash() -> Outcome {
     let mut w = world(H, ITERATIONS);
     w.gravity = Vector::ZERO;
@@ -207,10 +218,10 @@ pub fn smash() -> Outcome {
     let totals =
         |w: &PhysicsWorld| momentum_and_kinetic_energy(bodies.iter().map(|&b| motion(w, b)));
     let (p0, e0) = totals(&w);
-    let mut tracker = MomentumTracker::new(p0, e0);
+    let mut tracker = SmashTracker::new(p0, e0);
     let timing = measure(&mut w, smash::STEPS, PhysicsWorld::step, |w, _| {
         let (p, e) = totals(w);
-        tracker.update(p, e);
+        tracker.update(p, e, smash_poses(w, &bodies));
     });
     Outcome::new(timing, tracker.finish())
 }

@@ -441,6 +441,13 @@ pub mod smash {
     pub fn heavy_centre() -> (f64, f64) {
         (-10.0 - 0.5 * HEAVY, 0.5 * ROWS as f64 * SMALL)
     }
+
+    /// The pose of body `index`, in the order every engine adds them (the small boxes
+    /// row by row, then the heavy one), from its centre and angle (y up).
+    pub fn box_pose(index: usize, centre: (f64, f64), angle: f64) -> super::BoxPose {
+        let side = if index < ROWS * COLUMNS { SMALL } else { HEAVY };
+        super::BoxPose::new(centre, angle, 0.5 * side)
+    }
 }
 
 /// Joint grid (Box2D's benchmark): 100 × 100 bodies 1 m apart, each pinned to its right and
@@ -480,36 +487,170 @@ pub mod joint_grid {
     }
 }
 
-/// Watches a scene's total linear momentum and kinetic energy against their start.
-pub struct MomentumTracker {
+/// Watches the smash: its total linear momentum and kinetic energy against their start,
+/// and how deep its boxes pass into each other (`OverlapTracker`).
+pub struct SmashTracker {
     start: (f64, f64),
     start_energy: f64,
     worst: f64,
     energy_ratio: f64,
+    overlaps: OverlapTracker,
+    boxes: Vec<BoxPose>,
 }
 
-impl MomentumTracker {
+impl SmashTracker {
     pub fn new(momentum: (f64, f64), energy: f64) -> Self {
         Self {
             start: momentum,
             start_energy: energy,
             worst: 0.0,
             energy_ratio: 1.0,
+            overlaps: OverlapTracker::default(),
+            boxes: Vec::new(),
         }
     }
 
-    pub fn update(&mut self, momentum: (f64, f64), energy: f64) {
+    /// The totals now, and every box's pose.
+    pub fn update(
+        &mut self,
+        momentum: (f64, f64),
+        energy: f64,
+        boxes: impl Iterator<Item = BoxPose>,
+    ) {
         let size = self.start.0.hypot(self.start.1);
         let drift = (momentum.0 - self.start.0).hypot(momentum.1 - self.start.1) / size;
         self.worst = worst(self.worst, drift);
         self.energy_ratio = energy / self.start_energy;
+        self.boxes.clear();
+        self.boxes.extend(boxes);
+        self.overlaps.update(&self.boxes);
     }
 
     pub fn finish(&self) -> Metric {
         Metric::Momentum {
             drift: self.worst,
             energy_ratio: self.energy_ratio,
+            deepest_overlap: self.overlaps.deepest(),
         }
+    }
+}
+
+/// A square box's pose: centre, edge directions and half its side, m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoxPose {
+    centre: (f64, f64),
+    /// The box's two edge directions, found once (the smash has 9,601 boxes a step).
+    axes: [(f64, f64); 2],
+    half: f64,
+}
+
+impl BoxPose {
+    pub fn new(centre: (f64, f64), angle: f64, half: f64) -> Self {
+        let (s, c) = angle.sin_cos();
+        Self {
+            centre,
+            axes: [(c, s), (-s, c)],
+            half,
+        }
+    }
+
+    /// Half the box's extent along the unit vector `u`.
+    fn radius_along(&self, u: (f64, f64)) -> f64 {
+        let [e, f] = self.axes;
+        self.half * ((e.0 * u.0 + e.1 * u.1).abs() + (f.0 * u.0 + f.1 * u.1).abs())
+    }
+
+    /// The radius of the circle about the centre that holds the box.
+    fn circumradius(&self) -> f64 {
+        self.half * std::f64::consts::SQRT_2
+    }
+}
+
+/// How far two boxes overlap: the least overlap of their projections on the four edge
+/// directions (the separating-axis test), negative when one of them separates them.
+pub fn overlap(a: &BoxPose, b: &BoxPose) -> f64 {
+    let d = (b.centre.0 - a.centre.0, b.centre.1 - a.centre.1);
+    a.axes
+        .into_iter()
+        .chain(b.axes)
+        .map(|u| a.radius_along(u) + b.radius_along(u) - (d.0 * u.0 + d.1 * u.1).abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Watches the deepest overlap between any two of a scene's boxes over the run: how far
+/// bodies passed into each other, the same test on every engine's poses. Fast bodies that
+/// an engine lets through each other show here (or pass unseen between two steps).
+#[derive(Debug, Default)]
+pub struct OverlapTracker {
+    deepest: f64,
+    /// Scratch: each small box's grid cell and index, sorted.
+    cells: Vec<((i64, i64), u32)>,
+    big: Vec<u32>,
+}
+
+impl OverlapTracker {
+    pub fn update(&mut self, boxes: &[BoxPose]) {
+        self.deepest = worst(self.deepest, self.deepest_now(boxes));
+    }
+
+    /// The deepest overlap among `boxes` now (0 if none touch). Boxes are paired by a grid
+    /// of cells as wide as the smallest box's circle: two boxes of that size can overlap
+    /// only in the same or neighbouring cells. Bigger boxes are tested against every box.
+    fn deepest_now(&mut self, boxes: &[BoxPose]) -> f64 {
+        let Some(small) = boxes.iter().map(BoxPose::circumradius).reduce(f64::min) else {
+            return 0.0;
+        };
+        let cell = 2.0 * small;
+        self.cells.clear();
+        self.big.clear();
+        for (i, b) in boxes.iter().enumerate() {
+            if b.circumradius() > small {
+                self.big.push(i as u32);
+            } else {
+                let at = |x: f64| (x / cell).floor() as i64;
+                self.cells
+                    .push(((at(b.centre.0), at(b.centre.1)), i as u32));
+            }
+        }
+        self.cells.sort_unstable();
+        let mut deepest: f64 = 0.0;
+        let mut test = |i: u32, j: u32| {
+            let (a, b) = (&boxes[i as usize], &boxes[j as usize]);
+            let (dx, dy) = (b.centre.0 - a.centre.0, b.centre.1 - a.centre.1);
+            let reach = a.circumradius() + b.circumradius();
+            if dx * dx + dy * dy < reach * reach {
+                deepest = worst(deepest, overlap(a, b));
+            }
+        };
+        for (k, &big) in self.big.iter().enumerate() {
+            for other in (0..boxes.len() as u32).filter(|&o| o != big) {
+                // Two big boxes meet once, from the first of them.
+                if !self.big[..k].contains(&other) {
+                    test(big, other);
+                }
+            }
+        }
+        // Each cell against itself (later boxes) and four of its neighbours, so that a
+        // pair of cells is visited once.
+        for (n, &((x, y), i)) in self.cells.iter().enumerate() {
+            for (dx, dy) in [(0, 0), (1, -1), (1, 0), (1, 1), (0, 1)] {
+                let key = (x + dx, y + dy);
+                let from = if (dx, dy) == (0, 0) {
+                    n + 1
+                } else {
+                    self.cells.partition_point(|&(c, _)| c < key)
+                };
+                for &(_, j) in self.cells[from..].iter().take_while(|&&(c, _)| c == key) {
+                    test(i, j);
+                }
+            }
+        }
+        deepest
+    }
+
+    /// The deepest overlap seen, m.
+    pub fn deepest(&self) -> f64 {
+        self.deepest
     }
 }
 
@@ -547,6 +688,8 @@ pub enum Metric {
         drift: f64,
         /// Kinetic energy at the end over at the start.
         energy_ratio: f64,
+        /// The deepest any two boxes overlapped at the end of a step, m.
+        deepest_overlap: f64,
     },
 }
 
@@ -585,10 +728,13 @@ impl fmt::Display for Metric {
             Metric::Momentum {
                 drift,
                 energy_ratio,
+                deepest_overlap,
             } => write!(
                 f,
-                "momentum drift {drift:.1e} of P0; kinetic energy {:.1}% of the start",
-                100.0 * energy_ratio
+                "momentum drift {drift:.1e} of P0; kinetic energy {:.1}% of the start; \
+                 deepest overlap {:.0}% of a small box",
+                100.0 * energy_ratio,
+                100.0 * deepest_overlap / smash::SMALL
             ),
         }
     }
@@ -649,6 +795,62 @@ mod tests {
                     .all(|&t| bottom >= t - 1e-9 || y + 0.5 * BOX <= t - FLOOR.1 + 1e-9)
             );
         }
+    }
+
+    fn square(centre: (f64, f64), angle: f64, half: f64) -> BoxPose {
+        BoxPose::new(centre, angle, half)
+    }
+
+    #[test]
+    fn overlap_is_the_depth_of_the_shallowest_axis() {
+        let a = square((0.0, 0.0), 0.0, 0.5);
+        // Face to face, 0.1 m into each other; a quarter turn changes nothing.
+        let b = square((0.9, 0.3), 0.0, 0.5);
+        assert!((overlap(&a, &b) - 0.1).abs() < 1e-12);
+        let b = square((0.9, 0.3), PI / 2.0, 0.5);
+        assert!((overlap(&a, &b) - 0.1).abs() < 1e-12);
+        // A corner of a box turned 45° into a's face: it reaches √2/2 from its centre.
+        let b = square((1.1, 0.0), PI / 4.0, 0.5);
+        let corner = 0.5 + 0.5 * 2f64.sqrt() - 1.1;
+        assert!((overlap(&a, &b) - corner).abs() < 1e-12);
+        assert!((overlap(&b, &a) - corner).abs() < 1e-12);
+        // Apart: the gap, negative.
+        let b = square((1.5, 0.0), 0.0, 0.5);
+        assert!((overlap(&a, &b) + 0.5).abs() < 1e-12);
+    }
+
+    /// The grid finds the same deepest overlap as testing every pair, among small boxes
+    /// scattered densely enough to overlap, and two big ones.
+    #[test]
+    fn overlap_tracker_matches_every_pair() {
+        let mut seed: u64 = 2026;
+        let mut random = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20 {
+            let mut boxes: Vec<BoxPose> = (0..300)
+                .map(|_| square((20.0 * random(), 20.0 * random()), 7.0 * random(), 0.25))
+                .collect();
+            boxes.push(square((5.0, 5.0), random(), 4.0));
+            boxes.push(square((12.0, 9.0), random(), 3.0));
+            let mut every_pair: f64 = 0.0;
+            for (i, a) in boxes.iter().enumerate() {
+                for b in &boxes[i + 1..] {
+                    every_pair = every_pair.max(overlap(a, b));
+                }
+            }
+            let mut tracker = OverlapTracker::default();
+            tracker.update(&boxes);
+            assert!(every_pair > 0.0);
+            assert_eq!(tracker.deepest(), every_pair);
+        }
+        // Apart, nothing: the tracker's floor is 0.
+        let mut tracker = OverlapTracker::default();
+        tracker.update(&[square((0.0, 0.0), 0.0, 0.5), square((2.0, 0.0), 0.0, 0.5)]);
+        assert_eq!(tracker.deepest(), 0.0);
     }
 
     #[test]
