@@ -70,20 +70,30 @@ struct CachedManifold {
 }
 
 /// Last step's manifolds, sorted by pair, and this step's as they are found.
+///
+/// A pile at rest reuses every manifold of the last step, in order: this step's are then
+/// the first `kept_in_place` of `last`, and they are copied into `next` only once the
+/// step parts from them (a manifold stored afresh, or one of `last`'s left out).
 #[derive(Debug, Clone, Default)]
 pub struct ManifoldCache {
     last: Vec<CachedManifold>,
     next: Vec<CachedManifold>,
     cursor: usize,
+    /// `Some(n)`: this step's manifolds so far are `last[..n]`, and `next` is unused.
+    kept_in_place: Option<usize>,
 }
 
 impl ManifoldCache {
     /// Starts a step: the manifolds kept in the last one become the ones to reuse. Pairs
     /// must then be visited in increasing order.
     pub fn begin_step(&mut self) {
-        std::mem::swap(&mut self.last, &mut self.next);
+        match self.kept_in_place {
+            Some(kept) => self.last.truncate(kept),
+            None => std::mem::swap(&mut self.last, &mut self.next),
+        }
         self.next.clear();
         self.cursor = 0;
+        self.kept_in_place = Some(0);
     }
 
     /// Forgets every manifold.
@@ -91,6 +101,26 @@ impl ManifoldCache {
         self.last.clear();
         self.next.clear();
         self.cursor = 0;
+        self.kept_in_place = None;
+    }
+
+    /// This step's manifolds so far into `next`, if they were still kept in place.
+    fn part_from_last(&mut self) {
+        if let Some(kept) = self.kept_in_place.take() {
+            self.next.extend_from_slice(&self.last[..kept]);
+        }
+    }
+
+    /// The last step's manifold at `cursor`, reused: kept in place if it follows the ones
+    /// kept so far, else copied into `next`.
+    fn keep(&mut self) {
+        match &mut self.kept_in_place {
+            Some(kept) if *kept == self.cursor => *kept += 1,
+            _ => {
+                self.part_from_last();
+                self.next.push(self.last[self.cursor]);
+            }
+        }
     }
 
     /// The pair's last manifold at the current poses, if the pair has moved relative to
@@ -137,7 +167,7 @@ impl ManifoldCache {
         if manifold.points().is_empty() {
             return None;
         }
-        self.next.push(*cached);
+        self.keep();
         Some(manifold)
     }
 
@@ -167,6 +197,7 @@ impl ManifoldCache {
                 id: p.id,
             };
         }
+        self.part_from_last();
         self.next.push(CachedManifold {
             pair: (manifold.body_a.0, manifold.body_b.0),
             relative: relative_pose(pose_a, pose_b),
@@ -299,6 +330,59 @@ mod tests {
             [true, true],
             "both bodies served as reference"
         );
+    }
+
+    /// What a step keeps for the next: the manifolds it reused or stored, in pair order,
+    /// whether all of the last step's were reused in place, one was left out, or one was
+    /// stored afresh between two reused ones.
+    #[test]
+    fn a_step_keeps_what_it_reused_and_stored() {
+        let (poly_a, pose_a) = placed(&unit_square(), Vec2::zeros(), 0.0);
+        let (poly_b, pose_b) = placed(&unit_square(), Vec2::new(0.0, 0.999), 0.0);
+        let (margin, tie, tolerance) = (0.02, 0.001, 5e-4);
+        let manifold = |(i, j): (u32, u32)| {
+            collide_polygons(
+                (BodyHandle(i), &poly_a),
+                (BodyHandle(j), &poly_b),
+                margin,
+                tie,
+            )
+            .expect("in contact")
+        };
+        let pairs = [(0, 1), (0, 2), (1, 2)];
+        let reuse = |cache: &mut ManifoldCache, (i, j): (u32, u32)| {
+            let found = (BodyHandle(i), &pose_a);
+            cache.reuse(found, (BodyHandle(j), &pose_b), margin, tolerance)
+        };
+        let mut cache = ManifoldCache::default();
+        for pair in pairs {
+            cache.store(&manifold(pair), (&pose_a, &pose_b), margin);
+        }
+        // Every one reused, twice over (kept in place).
+        for _ in 0..2 {
+            cache.begin_step();
+            for pair in pairs {
+                assert!(reuse(&mut cache, pair).is_some());
+            }
+        }
+        // (0, 2) left out: gone at the next step.
+        cache.begin_step();
+        assert!(reuse(&mut cache, (0, 1)).is_some());
+        assert!(reuse(&mut cache, (1, 2)).is_some());
+        cache.begin_step();
+        assert!(reuse(&mut cache, (0, 1)).is_some());
+        assert!(reuse(&mut cache, (0, 2)).is_none());
+        // Stored afresh between the two reused ones: all three are there next.
+        cache.store(&manifold((0, 2)), (&pose_a, &pose_b), margin);
+        assert!(reuse(&mut cache, (1, 2)).is_some());
+        cache.begin_step();
+        for pair in pairs {
+            assert!(reuse(&mut cache, pair).is_some(), "{pair:?}");
+        }
+        // A step that visits nothing keeps nothing.
+        cache.begin_step();
+        cache.begin_step();
+        assert!(reuse(&mut cache, (0, 1)).is_none());
     }
 
     /// The two other refusals: a margin wider than the cached manifold's (it may have left
