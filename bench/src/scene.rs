@@ -623,11 +623,12 @@ impl OverlapTracker {
             }
         };
         for (k, &big) in self.big.iter().enumerate() {
-            for other in (0..boxes.len() as u32).filter(|&o| o != big) {
-                // Two big boxes meet once, from the first of them.
-                if !self.big[..k].contains(&other) {
-                    test(big, other);
-                }
+            for &(_, small) in &self.cells {
+                test(big, small);
+            }
+            // Two big boxes meet once, from the first of them.
+            for &other in &self.big[k + 1..] {
+                test(big, other);
             }
         }
         // Each cell against itself (later boxes) and four of its neighbours, so that a
