@@ -21,6 +21,21 @@ impl ContactMemory {
         }));
     }
 
+    /// Writes `impulses` (normal, tangent; one per contact, in their order) into
+    /// `contacts` and keeps them, in one pass through the contacts.
+    pub fn store_impulses(&mut self, contacts: &mut [Contact], impulses: &[(f64, f64)]) {
+        self.entries.clear();
+        self.entries.extend(
+            contacts
+                .iter_mut()
+                .zip(impulses)
+                .map(|(c, &(normal, tangent))| {
+                    (c.normal_impulse, c.tangent_impulse) = (normal, tangent);
+                    ((c.body_a, c.body_b, c.id.0), normal, tangent)
+                }),
+        );
+    }
+
     /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
     /// the order of `contacts`. Both lists come by body pair in increasing order, so one
     /// walk through the memory finds each pair's entries.
