@@ -37,31 +37,41 @@ impl ContactMemory {
     }
 
     /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
-    /// the order of `contacts`. Both lists come by body pair in increasing order, so one
-    /// walk through the memory finds each pair's entries.
+    /// the order of `contacts` (`recall_at` for each).
     pub fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {
         out.clear();
-        let mut cursor = 0;
-        let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
-        for (k, c) in contacts.iter().enumerate() {
-            // A pile at rest keeps its contacts from step to step, in the same order: the
-            // k-th entry is then this contact's (keys are unique, so the search below
-            // would find the same one).
-            let key = (c.body_a, c.body_b, c.id.0);
-            if let Some(m) = self.entries.get(k).filter(|m| m.0 == key) {
-                out.push((m.1, m.2));
-                continue;
-            }
-            let pair = (c.body_a, c.body_b);
-            while self.entries.get(cursor).is_some_and(|m| pair_of(m) < pair) {
-                cursor += 1;
-            }
-            let found = self.entries[cursor..]
-                .iter()
-                .take_while(|m| pair_of(m) == pair)
-                .find(|m| m.0.2 == c.id.0);
-            out.push(found.map_or((0.0, 0.0), |m| (m.1, m.2)));
+        let mut shift = 0;
+        let recalled = contacts.iter().enumerate();
+        out.extend(recalled.map(|(k, c)| self.recall_at(k, c, &mut shift)));
+    }
+
+    /// The last (normal, tangent) impulses of `contact`, the `k`-th of this step's
+    /// contacts; zeros for a new one. `shift` is where the last contact asked for was
+    /// found, relative to its index: the entry that far from `k` is tried first.
+    #[inline]
+    pub fn recall_at(&self, k: usize, contact: &Contact, shift: &mut isize) -> (f64, f64) {
+        // A pile at rest keeps its contacts from step to step, in the same order: the
+        // k-th entry is then this contact's (keys are unique). Where contacts came or
+        // went before it, those after it are most often shifted alike.
+        let key = (contact.body_a, contact.body_b, contact.id.0);
+        let guess = k.wrapping_add_signed(*shift);
+        if let Some(m) = self.entries.get(guess).filter(|m| m.0 == key) {
+            return (m.1, m.2);
         }
+        // Else among the entries of its pair: both lists come by body pair in
+        // increasing order.
+        let pair = (key.0, key.1);
+        let pair_of = |m: &((u32, u32, u32), f64, f64)| (m.0.0, m.0.1);
+        let start = self.entries.partition_point(|m| pair_of(m) < pair);
+        let found = self.entries[start..]
+            .iter()
+            .take_while(|m| pair_of(m) == pair)
+            .position(|m| m.0.2 == key.2);
+        found.map_or((0.0, 0.0), |offset| {
+            let index = start + offset;
+            *shift = index as isize - k as isize;
+            (self.entries[index].1, self.entries[index].2)
+        })
     }
 }
 

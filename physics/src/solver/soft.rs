@@ -327,7 +327,6 @@ pub struct SoftStepSolver {
     memory: ContactMemory,
     /// The step's (normal, tangent) impulses by contact, on their way to the contacts.
     impulses: Vec<(f64, f64)>,
-    recalled: Vec<(f64, f64)>,
     joint_memory: JointMemory,
     /// The pinned bodies' rotations at the step's start, found as the pins need them.
     rotations: Vec<Option<Rot>>,
@@ -480,7 +479,6 @@ impl SoftStepSolver {
         // and at rest, and past the bodies `store` writes back.
         self.bodies.push(SoftBody::null());
         self.points.clear();
-        self.memory.recall(contacts, &mut self.recalled);
         // The points are built island by island (each island's in the contacts' order):
         // grouping the contacts is cheaper than reordering the larger points afterwards.
         let grouped = self.contact_grouping.group(
@@ -496,6 +494,7 @@ impl SoftStepSolver {
         // points still in the cache), and `plan` below fills only a changed plan.
         self.plan.begin_filling();
         let mut open_manifold = None;
+        let mut shift = 0; // `ContactMemory::recall_at`'s
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -510,7 +509,7 @@ impl SoftStepSolver {
                 let k = a.inv_mass + b.inv_mass + a.inv_inertia * la * la + b.inv_inertia * lb * lb;
                 if k > 0.0 { 1.0 / k } else { 0.0 }
             };
-            let (normal_impulse, tangent_impulse) = self.recalled[i];
+            let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
             self.may_bounce |= c.restitution != 0.0;
             self.points.push(PointConstraint {
                 contact: i as u32,
