@@ -21,21 +21,6 @@ impl ContactMemory {
         }));
     }
 
-    /// Writes `impulses` (normal, tangent; one per contact, in their order) into
-    /// `contacts` and keeps them, in one pass through the contacts.
-    pub fn store_impulses(&mut self, contacts: &mut [Contact], impulses: &[(f64, f64)]) {
-        self.entries.clear();
-        self.entries.extend(
-            contacts
-                .iter_mut()
-                .zip(impulses)
-                .map(|(c, &(normal, tangent))| {
-                    (c.normal_impulse, c.tangent_impulse) = (normal, tangent);
-                    ((c.body_a, c.body_b, c.id.0), normal, tangent)
-                }),
-        );
-    }
-
     /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
     /// the order of `contacts` (`recall_at` for each).
     pub fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {

@@ -323,10 +323,8 @@ pub struct SoftStepSolver {
     points: Vec<PointConstraint>,
     joints: Vec<SoftJoint>,
     spare_joints: Vec<SoftJoint>,
-    /// Last step's contact impulses, and this step's contacts' share of them.
+    /// Last step's contact impulses, recalled as this step's points are built.
     memory: ContactMemory,
-    /// The step's (normal, tangent) impulses by contact, on their way to the contacts.
-    impulses: Vec<(f64, f64)>,
     joint_memory: JointMemory,
     /// The pinned bodies' rotations at the step's start, found as the pins need them.
     rotations: Vec<Option<Rot>>,
@@ -878,49 +876,32 @@ impl SoftStepSolver {
             b.position += s.dp;
             b.angle += s.dangle;
         }
-        // The impulses go by contact into `impulses` first: the batches hold their
-        // contacts scattered, and a contact is larger than its two impulses (a big
-        // pile's contacts do not fit in the cache, their impulses do). Every contact
-        // is one point's, so each entry is written below (tests build with debug
-        // assertions, which start them at NaN and check).
-        const UNSET: (f64, f64) = if cfg!(debug_assertions) {
-            (f64::NAN, f64::NAN)
-        } else {
-            (0.0, 0.0)
-        };
-        self.impulses.clear();
-        self.impulses.resize(contacts.len(), UNSET);
-        if !self.may_bounce {
-            // The batched points' impulses are still in their lanes: from there, and
-            // the rest (LCP islands, manifolds solved alone) from the points below.
-            self.plan.store_impulses(&mut self.impulses);
-        }
-        let impulses = &mut self.impulses;
-        let mut store_points = |points: &[PointConstraint]| {
+        let store_points = |points: &[PointConstraint], contacts: &mut [Contact]| {
             for p in points {
-                impulses[p.contact as usize] = (p.normal_impulse, p.tangent_impulse);
+                let c = &mut contacts[p.contact as usize];
+                c.normal_impulse = p.normal_impulse;
+                c.tangent_impulse = p.tangent_impulse;
             }
         };
         if self.may_bounce {
-            store_points(&self.points);
+            store_points(&self.points, contacts);
         } else {
+            // The batched points' impulses are still in their lanes: from there, and
+            // the rest (LCP islands, manifolds solved alone) from the points.
+            self.plan.store_impulses(contacts);
             for &(start, end, lcp) in &self.contact_lcp.all_islands {
                 if lcp {
-                    store_points(&self.points[start..end]);
+                    store_points(&self.points[start..end], contacts);
                 }
             }
             for item in &self.plan.items {
                 if let PassItem::Manifold(first, count) = *item {
                     let (first, count) = (first as usize, count as usize);
-                    store_points(&self.points[first..first + count]);
+                    store_points(&self.points[first..first + count], contacts);
                 }
             }
         }
-        debug_assert!(
-            self.impulses.iter().all(|i| !i.0.is_nan() && !i.1.is_nan()),
-            "every contact's impulses stored"
-        );
-        self.memory.store_impulses(contacts, &self.impulses);
+        self.memory.store(contacts);
         for j in &self.joints {
             self.joint_memory
                 .keep(j.input, (j.slot, j.impulse, j.motor_impulse));
