@@ -493,6 +493,10 @@ impl SoftStepSolver {
         self.plan.begin_filling();
         let mut open_manifold = None;
         let mut shift = 0; // `ContactMemory::recall_at`'s
+        // The contact before (bodies, normal), and whether its point was coupled with
+        // the one before it.
+        let mut last_contact = None;
+        let mut last_was_coupled = false;
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -536,14 +540,17 @@ impl SoftStepSolver {
             });
             // With the point before, one manifold's two points: coupled if their block
             // is well conditioned. Found here, while both are still in the cache.
+            // Whether it is, from the contact before: its point is still being written.
             let k = self.points.len() - 1;
-            let block = (k >= 1).then(|| {
+            let this_contact = (c.body_a, c.body_b, c.normal);
+            let same_manifold = last_contact == Some(this_contact);
+            last_contact = Some(this_contact);
+            let block = (same_manifold && !last_was_coupled).then(|| {
                 let (p, q) = (&self.points[k - 1], &self.points[k]);
-                let same_manifold = p.a == q.a && p.b == q.b && p.normal == q.normal;
-                let taken = k >= 2 && self.points[k - 2].pair_coupling.is_some();
                 let bodies = (&self.bodies[p.a as usize], &self.bodies[p.b as usize]);
-                (same_manifold && !taken).then(|| NormalBlock::of(bodies, (p, q)))?
+                NormalBlock::of(bodies, (p, q))
             });
+            last_was_coupled = matches!(block, Some(Some(_)));
             if let Some(block) = block.flatten() {
                 self.points[k - 1].pair_coupling = Some(block);
                 self.plan_inputs
