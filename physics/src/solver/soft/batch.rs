@@ -642,6 +642,11 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     /// Whether any lane's points may bounce: only then are `bounce`'s lanes read or
     /// written during the passes (they change nothing where restitution is 0).
     may_bounce: bool,
+    /// The lanes whose manifold may bounce, a bit each: only their `bounce` lanes are
+    /// written when filled and read back (`scatter`). The others' hold what an earlier
+    /// manifold left there, which the passes carry only into those same bounce lanes:
+    /// a pile's batches never touch them.
+    bouncing_lanes: u8,
     inv_inertia_a: L,
     inv_inertia_b: L,
     normal_x: L,
@@ -692,6 +697,7 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             k22: zero,
             inverse: [zero; 3],
             may_bounce: false,
+            bouncing_lanes: 0,
             points: [LanePoints::default(); N],
             contacts: [[PAD; LANES]; N],
             normal_impulses: [zero; N],
@@ -986,13 +992,22 @@ impl<const N: usize> ManifoldBatch<N> {
             lane.tangent_mass.0[k] = p.tangent_mass;
             lane.tangent_impulse.0[k] = p.tangent_impulse;
         }
-        for (lane, p) in self.bounce.iter_mut().zip(lane_points) {
-            self.may_bounce |= p.restitution != 0.0;
-            lane.restitution.0[k] = p.restitution;
-            lane.relative_velocity.0[k] = p.relative_velocity;
-            lane.max_normal_impulse.0[k] = p.max_normal_impulse;
-            lane.closing_acceleration.0[k] = p.closing_acceleration;
+        let bounces = lane_points[..N].iter().any(|p| p.restitution != 0.0);
+        let bit = 1 << k;
+        if bounces {
+            for (lane, p) in self.bounce.iter_mut().zip(lane_points) {
+                lane.restitution.0[k] = p.restitution;
+                lane.relative_velocity.0[k] = p.relative_velocity;
+                lane.max_normal_impulse.0[k] = p.max_normal_impulse;
+                lane.closing_acceleration.0[k] = p.closing_acceleration;
+            }
         }
+        self.may_bounce |= bounces;
+        self.bouncing_lanes = if bounces {
+            self.bouncing_lanes | bit
+        } else {
+            self.bouncing_lanes & !bit
+        };
     }
 
     /// The accumulated impulses, into the lanes' contacts.
@@ -1018,7 +1033,8 @@ impl<const N: usize> ManifoldBatch<N> {
                 let p = &mut points[self.first_point[k] as usize + which];
                 p.normal_impulse = normal[k];
                 p.tangent_impulse = tangent[k];
-                if self.may_bounce {
+                // A point that cannot bounce keeps its own, as the passes leave them.
+                if self.may_bounce && self.bouncing_lanes & (1 << k) != 0 {
                     p.max_normal_impulse = max_normal[k];
                     p.relative_velocity = relative[k];
                 }
@@ -1554,6 +1570,44 @@ mod tests {
                 let expected = state(&one_by_one, &their_points);
                 let label = format!("seed {seed}, bias {use_bias}");
                 assert_batch_gives::<2>((&bodies, &points), FIRSTS, &pass, &expected, &label);
+            }
+        }
+    }
+
+    /// A batch filled again solves as a fresh one, whatever its lanes held before: its
+    /// bounce lanes, which filling leaves in lanes that cannot bounce, included.
+    #[test]
+    fn a_batch_filled_again_solves_as_a_fresh_one() {
+        for seed in 1..=100u64 {
+            let (bodies, bouncing) = eight_manifolds(seed);
+            let mut resting = bouncing.clone();
+            for p in &mut resting {
+                p.restitution = 0.0;
+            }
+            // Half the lanes' manifolds may bounce, half not.
+            let mut mixed = bouncing.clone();
+            for p in &mut mixed[8..] {
+                p.restitution = 0.0;
+            }
+            let fills = [&bouncing, &resting, &mixed, &bouncing, &mixed, &resting];
+            let pass = pass(true);
+            let solved = |batch: &mut ManifoldBatch<2>, points: &[PointConstraint]| {
+                let (mut lanes, mut lane_points) = (bodies.clone(), points.to_vec());
+                batch.solve_on(LanePath::best(), &mut lanes, &pass);
+                batch.scatter(&mut lane_points);
+                state(&lanes, &lane_points)
+            };
+            let mut reused = ManifoldBatch::<2>::default();
+            for (k, points) in fills.into_iter().enumerate() {
+                let mut fresh = ManifoldBatch::<2>::default();
+                fresh.fill(FIRSTS, points, &bodies);
+                reused.fill(FIRSTS, points, &bodies);
+                let expected = solved(&mut fresh, points);
+                assert_eq!(
+                    solved(&mut reused, points),
+                    expected,
+                    "seed {seed}, fill {k}"
+                );
             }
         }
     }
