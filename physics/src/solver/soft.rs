@@ -539,8 +539,9 @@ impl SoftStepSolver {
                 pair_coupling: None,
             });
             // With the point before, one manifold's two points: coupled if their block
-            // is well conditioned. Found here, while both are still in the cache.
-            // Whether it is, from the contact before: its point is still being written.
+            // is well conditioned. Found here, while both are still in the cache; whether
+            // they are one manifold's is told from the contact before, not read back from
+            // the points just written.
             let k = self.points.len() - 1;
             let this_contact = (c.body_a, c.body_b, c.normal);
             let same_manifold = last_contact == Some(this_contact);
