@@ -493,10 +493,7 @@ impl SoftStepSolver {
         self.plan.begin_filling();
         let mut open_manifold = None;
         let mut shift = 0; // `ContactMemory::recall_at`'s
-        // The contact before (bodies, normal), and whether its point was coupled with
-        // the one before it.
-        let mut last_contact = None;
-        let mut last_was_coupled = false;
+        let mut last_contact = None; // (bodies, normal)
         for &(_, i) in grouped {
             let (i, c) = (i as usize, &contacts[i as usize]);
             let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
@@ -546,12 +543,13 @@ impl SoftStepSolver {
             let this_contact = (c.body_a, c.body_b, c.normal);
             let same_manifold = last_contact == Some(this_contact);
             last_contact = Some(this_contact);
-            let block = (same_manifold && !last_was_coupled).then(|| {
+            // The point before must have begun its manifold (`open_manifold`), not
+            // completed one.
+            let block = (same_manifold && open_manifold.is_some()).then(|| {
                 let (p, q) = (&self.points[k - 1], &self.points[k]);
                 let bodies = (&self.bodies[p.a as usize], &self.bodies[p.b as usize]);
                 NormalBlock::of(bodies, (p, q))
             });
-            last_was_coupled = matches!(block, Some(Some(_)));
             if let Some(block) = block.flatten() {
                 self.points[k - 1].pair_coupling = Some(block);
                 self.plan_inputs

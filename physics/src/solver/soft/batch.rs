@@ -328,15 +328,6 @@ impl PassPlan {
     /// change, `plan` fills it from the points.
     pub fn begin_filling(&mut self) {
         self.filled_while_built = self.kept_last_step;
-        if !self.filled_while_built {
-            return;
-        }
-        for batch in self.pairs.filled_mut() {
-            batch.may_bounce = false;
-        }
-        for batch in self.singles.filled_mut() {
-            batch.may_bounce = false;
-        }
     }
 
     /// The manifold of `count` points starting at `first`, just built, into the lane the
@@ -639,11 +630,9 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     first_point: [u32; LANES],
     a: [u32; LANES],
     b: [u32; LANES],
-    /// Whether any lane's points may bounce: only then are `bounce`'s lanes read or
-    /// written during the passes (they change nothing where restitution is 0).
-    may_bounce: bool,
     /// The lanes whose manifold may bounce, a bit each: only their `bounce` lanes are
-    /// written when filled and read back (`scatter`). The others' hold what an earlier
+    /// written when filled and read back (`scatter`), and only a batch with one reads or
+    /// writes any during the passes (`may_bounce`). The others' hold what an earlier
     /// manifold left there, which the passes carry only into those same bounce lanes:
     /// a pile's batches never touch them.
     bouncing_lanes: u8,
@@ -696,7 +685,6 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             k12: zero,
             k22: zero,
             inverse: [zero; 3],
-            may_bounce: false,
             bouncing_lanes: 0,
             points: [LanePoints::default(); N],
             contacts: [[PAD; LANES]; N],
@@ -938,7 +926,6 @@ impl<const N: usize> ManifoldBatch<N> {
     /// an unused lane, on the null body, the last of `bodies`).
     fn fill(&mut self, first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
         self.first_point = first_point;
-        self.may_bounce = false;
         let unused = first_point
             .contains(&PAD)
             .then(|| unused_lane(bodies.len() as u32 - 1));
@@ -1002,7 +989,6 @@ impl<const N: usize> ManifoldBatch<N> {
                 lane.closing_acceleration.0[k] = p.closing_acceleration;
             }
         }
-        self.may_bounce |= bounces;
         self.bouncing_lanes = if bounces {
             self.bouncing_lanes | bit
         } else {
@@ -1034,7 +1020,7 @@ impl<const N: usize> ManifoldBatch<N> {
                 p.normal_impulse = normal[k];
                 p.tangent_impulse = tangent[k];
                 // A point that cannot bounce keeps its own, as the passes leave them.
-                if self.may_bounce && self.bouncing_lanes & (1 << k) != 0 {
+                if self.bouncing_lanes & (1 << k) != 0 {
                     p.max_normal_impulse = max_normal[k];
                     p.relative_velocity = relative[k];
                 }
@@ -1044,6 +1030,13 @@ impl<const N: usize> ManifoldBatch<N> {
 }
 
 impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
+    /// Whether any lane's points may bounce: only then are `bounce`'s lanes read or
+    /// written during the passes (they change nothing where restitution is 0).
+    #[inline(always)]
+    fn may_bounce(&self) -> bool {
+        self.bouncing_lanes != 0
+    }
+
     /// Whether every lane's bodies are in `bodies`: checked once a pass, so that the
     /// gathers need not check each index.
     #[inline(always)]
@@ -1163,7 +1156,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         if N == 2 {
             self.solve_normals_together(&mut pair, &separations, &targets, pass);
         } else {
-            let bounce = self.may_bounce.then_some(&mut self.bounce[..]);
+            let bounce = self.may_bounce().then_some(&mut self.bounce[..]);
             let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
             solve_normals_alone(&mut pair, points, normal, &separations, &targets);
         }
@@ -1199,13 +1192,13 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         // Copied only when needed: the velocities and impulses, and the bounce lanes of a
         // batch that may bounce.
         let one_by_one = (soft_differs && mixed.any()).then(|| {
-            let bounce = self.may_bounce.then_some(self.bounce);
+            let bounce = self.may_bounce().then_some(self.bounce);
             (*pair, self.normal_impulses, bounce)
         });
         let points = &self.points[..];
         let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
         let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
-        if self.may_bounce {
+        if self.may_bounce() {
             approach(&mut self.bounce[0], v1, separations[0]);
             approach(&mut self.bounce[1], v2, separations[1]);
         }
@@ -1256,7 +1249,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             take_first.select(zero, take_second.select(second, zero)),
         );
         let normal = (self.normal_x, self.normal_y);
-        let may_bounce = self.may_bounce;
+        let may_bounce = self.may_bounce();
         let points = self.points.iter().zip(&mut self.normal_impulses);
         for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
             apply_normal(
@@ -1847,7 +1840,7 @@ mod tests {
                 lanes.chain(impulses).map(f64::to_bits).collect::<Vec<_>>()
             };
             assert_eq!(bits(batch), bits(&fresh));
-            assert_eq!(batch.may_bounce, fresh.may_bounce);
+            assert_eq!(batch.bouncing_lanes, fresh.bouncing_lanes);
         }
         points[batched].pair_coupling = None;
         plan_one_island(&mut plan, &points, &bodies);
