@@ -1445,9 +1445,9 @@ impl World {
                 .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
             s.fat_fixed.clear();
             s.fat_fixed.extend((0..bodies.len()).map(is_fixed));
-            let non_colliding = &self.non_colliding;
+            let (non_colliding, fixed) = (&self.non_colliding, &s.fat_fixed);
             let wanted = |i: usize, j: usize| {
-                let both_fixed = is_fixed(i) && is_fixed(j);
+                let both_fixed = fixed[i] & fixed[j];
                 !both_fixed && !non_colliding.contains((i as u32, j as u32))
             };
             s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
