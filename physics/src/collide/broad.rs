@@ -130,8 +130,9 @@ impl BroadPhase {
                     // cells, paired in one only: the cell of their overlap's lower corner,
                     // which both cover. Within a bucket the entries are in body order: i < j.
                     // The tests are combined without branching, and the pair written and
-                    // kept or dropped: taken one by one, each outcome was a coin toss that
-                    // the branch predictor lost half the time (the smash's grid).
+                    // kept or dropped: each goes either way from pair to pair, and taken one
+                    // by one as branches they cost more (the smash's grid: 8.25M cycles a
+                    // step, 6.8M this way).
                     let found = (other_cell == cell)
                         & ((xi.max(xj), yi.max(yj)) == cell)
                         & overlap(&bi, &bj)
