@@ -187,10 +187,12 @@ fn main() {
     write_doc(docs, "results.md", &report);
 }
 
-/// `pe <scene> [solver] [fresh] [forwards] [steps=N]`: one pile, grid or smash scene in pe
-/// alone, so that a profiler sees only pe's step (`fresh`: no manifold reuse; `forwards`:
-/// the soft step sweeps its colours in one order only; `steps=N`: exactly N steps, with no
-/// time budget, so that two builds' instruction counts compare).
+/// `pe <scene> [solver] [fresh] [forwards] [steps=N] [stages [from=K]]`: one pile, grid or
+/// smash scene in pe alone, so that a profiler sees only pe's step (`fresh`: no manifold
+/// reuse; `forwards`: the soft step sweeps its colours in one order only; `steps=N`:
+/// exactly N steps, with no time budget, so that two builds' instruction counts compare;
+/// `stages`, in a build with the feature `stages`: the fewest and the median cycles of each
+/// stage of the step, over the steps from the K-th, by default from half way).
 fn run_pe_alone() {
     let scene = std::env::args().nth(2).unwrap_or_default();
     let solver_name = std::env::args().nth(3).unwrap_or_else(|| "soft".into());
@@ -224,6 +226,41 @@ fn run_pe_alone() {
         std::process::exit(2);
     };
     println!("{scene} under pe {}: {outcome:?}", solver.name());
+    if flags.iter().any(|f| f == "stages") {
+        let from = flags
+            .iter()
+            .find_map(|f| f.strip_prefix("from=")?.parse().ok());
+        print_stage_cycles(from);
+    }
+}
+
+/// The table of `pe <scene> ... stages`: each stage's fewest and median cycles a step over
+/// the steps from `from` on (half way by default), from `pe::stage_clock`.
+fn print_stage_cycles(from: Option<usize>) {
+    use pe::stage_clock::{self, Stage};
+    if !stage_clock::ENABLED {
+        eprintln!("stages: build with `--features stages` to count them");
+        std::process::exit(2);
+    }
+    let steps = stage_clock::take_steps();
+    let from = from.unwrap_or(steps.len() / 2).min(steps.len());
+    let counted = &steps[from..];
+    if counted.is_empty() {
+        eprintln!("stages: no steps from step {from} on");
+        std::process::exit(2);
+    }
+    println!(
+        "\n| stage ({} steps from step {from}) | fewest cycles | median |",
+        counted.len()
+    );
+    println!("| --- | ---: | ---: |");
+    for (k, stage) in Stage::ALL.iter().enumerate() {
+        let mut cycles: Vec<u64> = counted.iter().map(|s| s[k]).collect();
+        cycles.sort_unstable();
+        let fewest = cycles[0];
+        let median = cycles[cycles.len() / 2];
+        println!("| {} | {fewest} | {median} |", stage.name());
+    }
 }
 
 /// The scenes of `pile`: every pile, the joint grid and the smash.

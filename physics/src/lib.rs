@@ -22,6 +22,7 @@ pub mod limits;
 pub mod math;
 pub mod shape;
 pub mod solver;
+pub mod stage_clock;
 pub mod world;
 
 pub use body::{Body, BodyDef, BodyError, BodyHandle};

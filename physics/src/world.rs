@@ -16,6 +16,7 @@ use crate::solver::simultaneous::{FrictionModel, IslandReport, SimultaneousSolve
 use crate::solver::soft::{SoftSettings, SoftStepSolver};
 use crate::solver::system::VelocityTargets;
 use crate::solver::{ContactSolver, SolverBody};
+use crate::stage_clock::{self, Stage};
 
 /// How velocities and positions advance over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -579,7 +580,9 @@ impl World {
         if !(0.0..=crate::limits::FRICTION).contains(&self.friction) {
             return Err(StepError::BadFriction(self.friction));
         }
+        let started = stage_clock::mark();
         self.advance(dt);
+        stage_clock::record(Stage::Step, started);
         Ok(())
     }
 
@@ -1469,9 +1472,12 @@ impl World {
     /// contact is found (as a speculative one) before the bodies meet, however fast; those
     /// that cannot act this step are then dropped (`drop_idle_manifolds`).
     fn detect_contacts(&mut self, dt: f64, pipeline: Pipeline) {
+        let started = stage_clock::mark();
         if !std::mem::take(&mut self.scratch.candidates_current) {
             self.find_candidate_pairs(dt);
         }
+        stage_clock::record(Stage::BroadPhase, started);
+        let started = stage_clock::mark();
         let s = &mut self.scratch;
         let margin = self.settings.contact_margin();
         self.manifolds.clear();
@@ -1518,6 +1524,8 @@ impl World {
                 self.manifolds.push(m);
             }
         }
+        stage_clock::record(Stage::NarrowPhase, started);
+        let started = stage_clock::mark();
         self.drop_idle_manifolds(margin);
         for m in &self.manifolds {
             let body = |h: BodyHandle| self.bodies.get(h.index()).and_then(Option::as_ref);
@@ -1562,6 +1570,7 @@ impl World {
                 });
             }
         }
+        stage_clock::record(Stage::Contacts, started);
     }
 
     /// Drops the speculative manifolds that cannot act this step: every point farther off

@@ -15,6 +15,7 @@ use super::joint::JointConstraint;
 use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
+use crate::stage_clock::{self, Stage};
 use batch::{LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 
 #[cfg(target_arch = "x86_64")]
@@ -427,7 +428,9 @@ impl SoftStepSolver {
             settings.joint_damping_ratio,
             h,
         );
+        let started = stage_clock::mark();
         self.prepare(bodies, accelerations, contacts, joints);
+        stage_clock::record(Stage::Preparing, started);
         for _ in 0..settings.substeps {
             let order = if settings.alternating_sweeps {
                 SweepOrder::of_substep(self.substeps_taken)
@@ -436,10 +439,14 @@ impl SoftStepSolver {
             };
             self.substeps_taken = self.substeps_taken.wrapping_add(1);
             self.integrate_velocities(accelerations, h);
+            let started = stage_clock::mark();
             self.warm_start();
+            stage_clock::record(Stage::WarmStart, started);
+            let started = stage_clock::mark();
             self.solve(h, &contact_soft, &joint_soft, settings, true, order);
             self.integrate_positions(h);
             self.solve(h, &contact_soft, &joint_soft, settings, false, order);
+            stage_clock::record(Stage::Solve, started);
             // Warm starting re-applies the accumulated impulse in every substep, so the
             // step's total is the sum of the substeps' accumulated values.
             for &k in &self.motor_joints {

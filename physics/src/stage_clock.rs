@@ -1,0 +1,137 @@
+//! Cycles spent in each stage of a step, for profiling. With the feature `stage-clock`
+//! each stage is timed by the processor's time-stamp counter (`rdtsc` on x86-64,
+//! nanoseconds elsewhere) and every step's counts are kept; without it every function here
+//! is empty and compiles away.
+//!
+//! Why not wall-clock medians: on a shared machine those drift by tens of percent, while
+//! the fewest cycles a stage took over many steps of one run move by 1–2%, which is what a
+//! change of a few percent needs (docs/bench/profile.md, "Cycles per stage").
+
+/// The stages a step is timed in. The soft step's three (preparing, warm start, solve)
+/// are timed under `ContactSolver::Soft` and `Auto` only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// A whole `World::step`.
+    Step,
+    /// Bounds and candidate pairs (`World::find_candidate_pairs`).
+    BroadPhase,
+    /// A manifold for each candidate pair, reused or by SAT.
+    NarrowPhase,
+    /// Idle manifolds dropped, and the contacts built from the rest.
+    Contacts,
+    /// The soft step's islands, points, plan and lanes.
+    Preparing,
+    /// The soft step's warm starts, all substeps.
+    WarmStart,
+    /// The soft step's passes with and without bias, positions integrated between them.
+    Solve,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 7] = [
+        Stage::Step,
+        Stage::BroadPhase,
+        Stage::NarrowPhase,
+        Stage::Contacts,
+        Stage::Preparing,
+        Stage::WarmStart,
+        Stage::Solve,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Step => "whole step",
+            Stage::BroadPhase => "broad phase",
+            Stage::NarrowPhase => "narrow phase",
+            Stage::Contacts => "contacts",
+            Stage::Preparing => "preparing",
+            Stage::WarmStart => "warm start",
+            Stage::Solve => "solve",
+        }
+    }
+}
+
+/// Whether this build counts (the feature `stage-clock`).
+pub const ENABLED: bool = cfg!(feature = "stage-clock");
+
+/// When a stage began (`mark`).
+#[derive(Debug, Clone, Copy)]
+pub struct Mark(#[cfg(feature = "stage-clock")] u64);
+
+#[cfg(feature = "stage-clock")]
+mod counting {
+    use super::Stage;
+    use std::sync::Mutex;
+
+    /// This step's counts so far, and every finished step's, across the process.
+    pub(super) struct Counts {
+        pub current: [u64; Stage::ALL.len()],
+        pub steps: Vec<[u64; Stage::ALL.len()]>,
+    }
+
+    pub(super) static COUNTS: Mutex<Counts> = Mutex::new(Counts {
+        current: [0; Stage::ALL.len()],
+        steps: Vec::new(),
+    });
+
+    #[inline(always)]
+    pub(super) fn now() -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: `rdtsc` has no preconditions on x86-64.
+            unsafe { std::arch::x86_64::_rdtsc() }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            use std::sync::OnceLock;
+            use std::time::Instant;
+            static START: OnceLock<Instant> = OnceLock::new();
+            START.get_or_init(Instant::now).elapsed().as_nanos() as u64
+        }
+    }
+}
+
+/// Now, as the start of a stage.
+#[inline(always)]
+pub fn mark() -> Mark {
+    #[cfg(feature = "stage-clock")]
+    {
+        Mark(counting::now())
+    }
+    #[cfg(not(feature = "stage-clock"))]
+    {
+        Mark()
+    }
+}
+
+/// Adds the time since `since` to `stage`'s count for this step; `Stage::Step` ends the
+/// step, keeping its counts.
+#[inline(always)]
+pub fn record(stage: Stage, since: Mark) {
+    #[cfg(feature = "stage-clock")]
+    {
+        let elapsed = counting::now().wrapping_sub(since.0);
+        let mut counts = counting::COUNTS.lock().unwrap_or_else(|e| e.into_inner());
+        counts.current[stage as usize] += elapsed;
+        if stage == Stage::Step {
+            let finished = std::mem::take(&mut counts.current);
+            counts.steps.push(finished);
+        }
+    }
+    #[cfg(not(feature = "stage-clock"))]
+    let _ = (stage, since);
+}
+
+/// Every finished step's counts since the last call, by `Stage::ALL`'s order (none
+/// without the feature).
+pub fn take_steps() -> Vec<[u64; Stage::ALL.len()]> {
+    #[cfg(feature = "stage-clock")]
+    {
+        let mut counts = counting::COUNTS.lock().unwrap_or_else(|e| e.into_inner());
+        std::mem::take(&mut counts.steps)
+    }
+    #[cfg(not(feature = "stage-clock"))]
+    {
+        Vec::new()
+    }
+}
