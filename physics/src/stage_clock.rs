@@ -135,3 +135,37 @@ pub fn take_steps() -> Vec<[u64; Stage::ALL.len()]> {
         Vec::new()
     }
 }
+
+/// Run alone (`cargo test -p pe --features stage-clock --lib stage_clock`, as CI does): the
+/// counts are the process's, and other tests stepping worlds at the same time would add
+/// theirs.
+#[cfg(all(test, feature = "stage-clock"))]
+mod tests {
+    use super::*;
+    use crate::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
+
+    /// A box resting on a floor under the soft step, three steps: three steps counted,
+    /// every stage took time, and the stages, which lie inside the step, add up to less.
+    #[test]
+    fn each_step_counts_its_stages() {
+        let mut w = World::new(Vec2::new(0.0, 10.0));
+        w.settings.contact_solver = ContactSolver::Soft;
+        let floor = ConvexPolygon::rectangle(10.0, 1.0).unwrap();
+        w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 1.0), 0.0))
+            .unwrap();
+        let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        w.add_body(BodyDef::new(square, 1.0).at(Vec2::new(0.0, 0.0), 0.0))
+            .unwrap();
+        take_steps();
+        for _ in 0..3 {
+            w.step(1.0 / 60.0);
+        }
+        let steps = take_steps();
+        assert_eq!(steps.len(), 3);
+        for counts in steps {
+            assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
+            let inside: u64 = counts[1..].iter().sum();
+            assert!(inside < counts[Stage::Step as usize], "{counts:?}");
+        }
+    }
+}
