@@ -1765,6 +1765,71 @@ mod tests {
     use super::*;
     use crate::shape::ConvexPolygon;
 
+    /// A manifold that goes into the kept plan's lanes is not written to the soft step's
+    /// points; when the plan changes after all, or something bounces, they are built
+    /// again. A pile stepped so must move exactly as one whose every point is written,
+    /// through a box landing on it (the plan changes) and one bouncing on its top box
+    /// (restitution is the smaller of the two bodies': only the top box has any).
+    #[test]
+    fn points_left_unwritten_change_no_step() {
+        let (h, rows) = (1.0 / 60.0, 8);
+        let pile = |write_every_point| {
+            let mut world = World::new(Vec2::new(0.0, 10.0));
+            world.settings.contact_solver = ContactSolver::Soft;
+            world.friction = 0.6;
+            let floor = ConvexPolygon::rectangle(40.0, 1.0).unwrap();
+            world
+                .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+                .unwrap();
+            let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+            for row in 0..rows {
+                for i in 0..rows - row {
+                    let x = i as f64 - 0.5 * (rows - 1 - row) as f64;
+                    let centre = Vec2::new(x, -0.5 - row as f64);
+                    let def = BodyDef::new(unit.clone(), 1.0).at(centre, 0.0);
+                    let top = row == rows - 1;
+                    world
+                        .add_body(if top { def.restitution(0.5) } else { def })
+                        .unwrap();
+                }
+            }
+            world.scratch.soft.write_every_point = write_every_point;
+            world
+        };
+        let (mut skipping, mut writing) = (pile(false), pile(true));
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for step in 0..300 {
+            let dropped = match step {
+                90 => Some((BodyDef::new(unit.clone(), 1.0), -3.0)),
+                180 => Some((BodyDef::new(unit.clone(), 1.0).restitution(0.5), 0.1)),
+                _ => None,
+            };
+            if let Some((def, x)) = dropped {
+                let def = def.at(Vec2::new(x, -(rows as f64) - 3.0), 0.1);
+                skipping.add_body(def.clone()).unwrap();
+                writing.add_body(def).unwrap();
+            }
+            skipping.step(h);
+            writing.step(h);
+            let bits = |w: &World| -> Vec<u64> {
+                w.bodies()
+                    .flat_map(|(_, b)| b.state())
+                    .map(f64::to_bits)
+                    .collect()
+            };
+            assert_eq!(bits(&skipping), bits(&writing), "step {step}");
+        }
+        let (skipped, rebuilt) = skipping.scratch.soft.steps_skipping;
+        assert!(skipped > 200, "{skipped} steps left points unwritten");
+        // The landing's step or two, and every step from the bouncing box's first
+        // contact on.
+        assert!(
+            (50..150).contains(&rebuilt),
+            "{rebuilt} built their points again"
+        );
+        assert_eq!(writing.scratch.soft.steps_skipping, (0, 0));
+    }
+
     /// The broad phase keeps its pairs while bodies stay inside their grown bounds; the
     /// candidates must still be exactly the pairs whose bounds overlap now.
     #[test]

@@ -167,7 +167,7 @@ impl SoftBody {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct PointConstraint {
     contact: u32,
     a: u32,
@@ -190,8 +190,6 @@ struct PointConstraint {
     max_normal_impulse: f64,
     /// How fast gravity and forces close the gap (along −normal), for the impact speed.
     closing_acceleration: f64,
-    /// Solved with its island's other points as one LCP (see `ContactLcp`).
-    in_lcp: bool,
     /// With the next point: their 2 × 2 normal mass matrix, when the two are one
     /// manifold's and the block is well conditioned (solved together).
     pair_coupling: Option<NormalBlock>,
@@ -354,6 +352,12 @@ pub struct SoftStepSolver {
     substeps_taken: u64,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
+    /// Tests only: every point written, as if no manifold went straight into its lane.
+    #[cfg(test)]
+    pub(crate) write_every_point: bool,
+    /// Tests only: steps that left points unwritten, and steps that built them again.
+    #[cfg(test)]
+    pub(crate) steps_skipping: (usize, usize),
 }
 
 /// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
@@ -483,116 +487,43 @@ impl SoftStepSolver {
         // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
         // and at rest, and past the bodies `store` writes back.
         self.bodies.push(SoftBody::null());
-        self.points.clear();
         // The points are built island by island (each island's in the contacts' order):
         // grouping the contacts is cheaper than reordering the larger points afterwards.
-        let grouped = self.contact_grouping.group(
+        let mut grouping = std::mem::take(&mut self.contact_grouping);
+        let grouped = grouping.group(
             contacts.len(),
             bodies.len(),
             |i| (contacts[i].body_a, contacts[i].body_b),
             |i| self.bodies[i as usize].moves(),
         );
         island_ranges(grouped, &mut self.contact_islands);
-        self.plan_inputs.clear();
-        self.may_bounce = false;
-        // Each manifold goes into the kept plan's lanes as soon as it is complete (its
-        // points still in the cache), and `plan` below fills only a changed plan.
+        // Each manifold goes into the kept plan's lanes as soon as it is complete, and
+        // then its points are not written: on a big pile at rest, writing them was a
+        // tenth of the step (docs/bench/profile.md, "Points not written").
         self.plan.begin_filling();
-        let mut open_manifold = None;
-        let mut shift = 0; // `ContactMemory::recall_at`'s
-        let mut last_contact = None; // (bodies, normal)
-        for &(_, i) in grouped {
-            let (i, c) = (i as usize, &contacts[i as usize]);
-            let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-            let r_a = c.point - a.position;
-            let r_b = c.point - b.position;
-            let levers = PointLevers {
-                normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-                reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
-            };
-            // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
-            let mass = |(la, lb): (f64, f64)| {
-                let k = a.inv_mass + b.inv_mass + a.inv_inertia * la * la + b.inv_inertia * lb * lb;
-                if k > 0.0 { 1.0 / k } else { 0.0 }
-            };
-            let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
-            self.may_bounce |= c.restitution != 0.0;
-            self.points.push(PointConstraint {
-                contact: i as u32,
-                a: c.body_a,
-                b: c.body_b,
-                normal: c.normal,
-                levers,
-                base_separation: -c.depth,
-                normal_mass: mass(levers.normal),
-                tangent_mass: mass(levers.tangent()),
-                friction: c.friction,
-                restitution: c.restitution,
-                relative_velocity: c.approach_velocity,
-                normal_impulse,
-                tangent_impulse,
-                max_normal_impulse: 0.0,
-                // Read only for points that may bounce (`approach`).
-                closing_acceleration: if c.restitution == 0.0 {
-                    0.0
-                } else {
-                    -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
-                        .dot(&c.normal)
-                },
-                in_lcp: false,
-                pair_coupling: None,
-            });
-            // With the point before, one manifold's two points: coupled if their block
-            // is well conditioned. Found here, while both are still in the cache; whether
-            // they are one manifold's is told from the contact before, not read back from
-            // the points just written.
-            let k = self.points.len() - 1;
-            let this_contact = (c.body_a, c.body_b, c.normal);
-            let same_manifold = last_contact == Some(this_contact);
-            last_contact = Some(this_contact);
-            // The point before must have begun its manifold (`open_manifold`), not
-            // completed one.
-            let block = (same_manifold && open_manifold.is_some()).then(|| {
-                let (p, q) = (&self.points[k - 1], &self.points[k]);
-                let bodies = (&self.bodies[p.a as usize], &self.bodies[p.b as usize]);
-                NormalBlock::of(bodies, (p, q))
-            });
-            if let Some(block) = block.flatten() {
-                self.points[k - 1].pair_coupling = Some(block);
-                self.plan_inputs
-                    .last_mut()
-                    .expect("the first point's entry")
-                    .add_second_point();
-                self.plan
-                    .fill_manifold(k - 1, 2, &self.points, &self.bodies);
-                open_manifold = None;
-            } else {
-                let moves = |i: u32| self.bodies[i as usize].moves();
-                self.plan_inputs.push(PlanInput::new(
-                    (c.body_a, c.body_b),
-                    k,
-                    (moves(c.body_a), moves(c.body_b)),
-                    c.normal,
-                ));
-                // The point before, if it began a manifold, was that manifold's only one.
-                if let Some(single) = open_manifold.replace(k) {
-                    self.plan
-                        .fill_manifold(single, 1, &self.points, &self.bodies);
-                }
-            }
-        }
-        if let Some(single) = open_manifold {
-            self.plan
-                .fill_manifold(single, 1, &self.points, &self.bodies);
-        }
+        let skipped = self.build_points(bodies, accelerations, contacts, grouped);
         self.contact_lcp
-            .prepare(&self.bodies, &mut self.points, &self.contact_islands);
-        self.plan.plan(
-            &self.contact_islands,
-            &self.plan_inputs,
-            &self.points,
-            &self.bodies,
-        );
+            .prepare(&self.bodies, &self.points, &self.contact_islands);
+        let kept = self
+            .plan
+            .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+        #[cfg(test)]
+        {
+            self.steps_skipping.0 += usize::from(skipped);
+            self.steps_skipping.1 += usize::from(skipped && (!kept || self.may_bounce));
+        }
+        if skipped && (!kept || self.may_bounce) {
+            // The plan changed after all, or something bounces (restitution reads every
+            // point): every point is built again, and written.
+            self.plan.stop_filling();
+            self.build_points(bodies, accelerations, contacts, grouped);
+            self.contact_lcp
+                .prepare(&self.bodies, &self.points, &self.contact_islands);
+            self.plan
+                .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+        }
+        self.contact_grouping = grouping;
+        self.plan.plan(&self.points, &self.bodies);
         // Each pinned body's rotation once: a body of a net carries four pins.
         self.rotations.clear();
         if !joints.is_empty() {
@@ -652,6 +583,142 @@ impl SoftStepSolver {
             .enumerate()
             .filter(|(_, j)| j.motor.is_some());
         self.motor_joints.extend(motors.map(|(k, _)| k as u32));
+    }
+
+    /// The contacts' points, in the order of `grouped` (island by island), their
+    /// manifolds' entries for the plan (`plan_inputs`), and `may_bounce`. A manifold
+    /// that goes into the kept plan's lanes (`PassPlan::fill_manifold`) is not written to
+    /// `points`, unless its island is small enough to be solved as an LCP (which reads
+    /// its points): its entries there are left from an earlier step. Returns whether any
+    /// was left so. Such entries are read only by a changed plan and where something may
+    /// bounce (restitution, and the impulses stored from the points), and `prepare` then
+    /// builds the points again, with the filling stopped.
+    fn build_points(
+        &mut self,
+        bodies: &[SolverBody],
+        accelerations: &[(Vec2, f64)],
+        contacts: &[Contact],
+        grouped: &[(u32, u32)],
+    ) -> bool {
+        if self.points.len() < contacts.len() {
+            self.points
+                .resize(contacts.len(), PointConstraint::default());
+        }
+        self.points.truncate(contacts.len());
+        self.plan_inputs.clear();
+        self.may_bounce = false;
+        let mut skipped = false;
+        // The manifold begun by the point before, not yet complete: its first point's
+        // index, whether its island is small (below), and where in `pending` its point
+        // is; each point is built into the other place (`next`), and never moved.
+        let mut open: Option<(usize, bool, usize)> = None;
+        let mut pending = [PointConstraint::default(); 2];
+        let mut next = 0;
+        let mut shift = 0; // `ContactMemory::recall_at`'s
+        let mut last_contact = None; // (bodies, normal)
+        // The island of the current point: where it ends, and whether it may be an LCP
+        // island (`ContactLcp::prepare`), which reads its points.
+        let (mut island, mut island_end, mut small_island) = (0, 0, true);
+        // A complete manifold: into its lane, or else written to the points.
+        let mut complete =
+            |this: &mut Self, first: usize, manifold: &[&PointConstraint], small: bool| {
+                let in_lane = this.plan.fill_manifold(first, manifold, &this.bodies);
+                #[cfg(test)]
+                let small = small || this.write_every_point;
+                if in_lane && !small {
+                    skipped = true;
+                } else {
+                    for (to, p) in this.points[first..].iter_mut().zip(manifold) {
+                        *to = **p;
+                    }
+                }
+            };
+        for (k, &(_, i)) in grouped.iter().enumerate() {
+            if k == island_end {
+                let (start, end) = self.contact_islands[island];
+                (island, island_end, small_island) =
+                    (island + 1, end, end - start <= LCP_POINT_LIMIT);
+            }
+            let (i, c) = (i as usize, &contacts[i as usize]);
+            let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+            let r_a = c.point - a.position;
+            let r_b = c.point - b.position;
+            let levers = PointLevers {
+                normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
+                reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
+            };
+            // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
+            let mass = |(la, lb): (f64, f64)| {
+                let k = a.inv_mass + b.inv_mass + a.inv_inertia * la * la + b.inv_inertia * lb * lb;
+                if k > 0.0 { 1.0 / k } else { 0.0 }
+            };
+            let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
+            self.may_bounce |= c.restitution != 0.0;
+            pending[next] = PointConstraint {
+                contact: i as u32,
+                a: c.body_a,
+                b: c.body_b,
+                normal: c.normal,
+                levers,
+                base_separation: -c.depth,
+                normal_mass: mass(levers.normal),
+                tangent_mass: mass(levers.tangent()),
+                friction: c.friction,
+                restitution: c.restitution,
+                relative_velocity: c.approach_velocity,
+                normal_impulse,
+                tangent_impulse,
+                max_normal_impulse: 0.0,
+                // Read only for points that may bounce (`approach`).
+                closing_acceleration: if c.restitution == 0.0 {
+                    0.0
+                } else {
+                    -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
+                        .dot(&c.normal)
+                },
+                pair_coupling: None,
+            };
+            let point = &pending[next];
+            // With the point before, one manifold's two points: coupled if their block
+            // is well conditioned. Whether they are one manifold's is told from the
+            // contact before.
+            let this_contact = (c.body_a, c.body_b, c.normal);
+            let same_manifold = last_contact == Some(this_contact);
+            last_contact = Some(this_contact);
+            let block = open.filter(|_| same_manifold).and_then(|(_, _, at)| {
+                let bodies = (
+                    &self.bodies[c.body_a as usize],
+                    &self.bodies[c.body_b as usize],
+                );
+                NormalBlock::of(bodies, (&pending[at], point))
+            });
+            if let Some(block) = block {
+                let (first, small, at) = open.take().expect("the manifold's first point");
+                pending[at].pair_coupling = Some(block);
+                self.plan_inputs
+                    .last_mut()
+                    .expect("the first point's entry")
+                    .add_second_point();
+                complete(self, first, &[&pending[at], &pending[next]], small);
+            } else {
+                let moves = |i: u32| self.bodies[i as usize].moves();
+                self.plan_inputs.push(PlanInput::new(
+                    (c.body_a, c.body_b),
+                    k,
+                    (moves(c.body_a), moves(c.body_b)),
+                    c.normal,
+                ));
+                // The point before, if it began a manifold, was that manifold's only one.
+                if let Some((single, small, at)) = open.replace((k, small_island, next)) {
+                    complete(self, single, &[&pending[at]], small);
+                }
+                next = 1 - next;
+            }
+        }
+        if let Some((single, small, at)) = open {
+            complete(self, single, &[&pending[at]], small);
+        }
+        skipped
     }
 
     /// Records how each island of contacts and of pins was solved.
@@ -1437,7 +1504,7 @@ impl ContactLcp {
     fn prepare(
         &mut self,
         bodies: &[SoftBody],
-        points: &mut [PointConstraint],
+        points: &[PointConstraint],
         islands: &[(usize, usize)],
     ) {
         self.islands.clear();
@@ -1482,9 +1549,6 @@ impl ContactLcp {
                             }
                         }
                     }
-                }
-                for p in &mut points[start..end] {
-                    p.in_lcp = true;
                 }
                 self.islands.push((start, end, offset));
             }

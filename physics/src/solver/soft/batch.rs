@@ -127,6 +127,8 @@ pub(super) struct PassPlan {
     /// Whether this step's manifolds were written into the kept plan's lanes as they
     /// were built (`begin_filling`), so that `plan` need not fill the batches again.
     filled_while_built: bool,
+    /// Whether the manifolds last `read` are the last plan's.
+    inputs_kept: bool,
     /// Whether the last step kept the plan before it. One that changed will most likely
     /// change again (debris in flight: every step of the smash), and its lanes are then
     /// filled once the new plan is made rather than also while the points are built.
@@ -207,19 +209,19 @@ impl PlanInput {
 }
 
 impl PassPlan {
-    /// Plans the passes over `points`, grouped by `islands` (index ranges of `points`),
-    /// whose manifolds are `manifolds` in the points' order; islands solved as one LCP
-    /// are left out.
-    pub fn plan(
-        &mut self,
-        islands: &[(usize, usize)],
-        manifolds: &[PlanInput],
-        points: &[PointConstraint],
-        bodies: &[SoftBody],
-    ) {
-        self.read_inputs(islands, manifolds, points);
+    /// Reads this step's manifolds, `manifolds` in the points' order, grouped by `islands`
+    /// (index ranges of the points, and whether the island is solved as one LCP: those
+    /// are left out). Whether they are the last plan's: then `plan` keeps it.
+    pub fn read(&mut self, islands: &[(usize, usize, bool)], manifolds: &[PlanInput]) -> bool {
+        self.read_inputs(islands, manifolds);
+        self.inputs_kept = self.inputs == self.last_inputs;
+        self.inputs_kept
+    }
+
+    /// Plans the passes over `points`, for the manifolds last `read`.
+    pub fn plan(&mut self, points: &[PointConstraint], bodies: &[SoftBody]) {
         let filled_while_built = std::mem::take(&mut self.filled_while_built);
-        self.kept_last_step = self.inputs == self.last_inputs;
+        self.kept_last_step = self.inputs_kept;
         if self.kept_last_step {
             // A pile at rest: the same manifolds between the same bodies.
             if !filled_while_built {
@@ -330,44 +332,44 @@ impl PassPlan {
         self.filled_while_built = self.kept_last_step;
     }
 
-    /// The manifold of `count` points starting at `first`, just built, into the lane the
-    /// kept plan has for it, if any and of its size.
+    /// Fills no more lanes while the points are built: `plan` fills them (the points
+    /// are being built again, all written, for a plan that changed after all).
+    pub fn stop_filling(&mut self) {
+        self.filled_while_built = false;
+    }
+
+    /// The manifold of points `manifold` whose first point is `first`, just built, into
+    /// the lane the kept plan has for it, if any and of its size: whether it went into one.
     #[inline]
     pub fn fill_manifold(
         &mut self,
         first: usize,
-        count: usize,
-        points: &[PointConstraint],
+        manifold: &[&PointConstraint],
         bodies: &[SoftBody],
-    ) {
+    ) -> bool {
         if !self.filled_while_built {
-            return;
+            return false;
         }
         let Some(&slot) = self.slot_of.get(first).filter(|&&s| s != NO_SLOT) else {
-            return;
+            return false;
         };
         let (two_points, batch, lane) = Slot::unpack(slot);
-        let manifold = &points[first..first + count];
-        match (two_points, count) {
+        match (two_points, manifold.len()) {
             (true, 2) => self.pairs.batches[batch].fill_lane(lane, first as u32, manifold, bodies),
             (false, 1) => {
                 self.singles.batches[batch].fill_lane(lane, first as u32, manifold, bodies)
             }
-            _ => {} // the plan changes this step
+            _ => return false, // the plan changes this step
         }
+        true
     }
 
     /// The manifolds outside the LCP islands, each marked if its island is coloured,
     /// into `inputs`.
-    fn read_inputs(
-        &mut self,
-        islands: &[(usize, usize)],
-        manifolds: &[PlanInput],
-        points: &[PointConstraint],
-    ) {
+    fn read_inputs(&mut self, islands: &[(usize, usize, bool)], manifolds: &[PlanInput]) {
         self.inputs.clear();
         let mut next = 0;
-        for &(start, end) in islands {
+        for &(start, end, lcp) in islands {
             // The islands cover the points in order, so their manifolds follow each other.
             let from = next;
             while manifolds
@@ -376,7 +378,7 @@ impl PassPlan {
             {
                 next += 1;
             }
-            if points[start].in_lcp {
+            if lcp {
                 continue;
             }
             let coloured = if end - start >= MIN_COLOURED_ISLAND {
@@ -934,21 +936,22 @@ impl<const N: usize> ManifoldBatch<N> {
                 Some(unused) if first == PAD => &unused[..],
                 _ => &points[first as usize..],
             };
-            self.fill_lane(k, first, lane_points, bodies);
+            let lane_points: [&PointConstraint; N] = std::array::from_fn(|j| &lane_points[j]);
+            self.fill_lane(k, first, &lane_points, bodies);
         }
     }
 
-    /// Lane `k`: the manifold whose points begin `lane_points` (its first point `first`).
+    /// Lane `k`: the manifold whose points are `lane_points` (its first point `first`).
     #[inline(always)]
     fn fill_lane(
         &mut self,
         k: usize,
         first: u32,
-        lane_points: &[PointConstraint],
+        lane_points: &[&PointConstraint],
         bodies: &[SoftBody],
     ) {
         self.first_point[k] = first;
-        let p = &lane_points[0];
+        let p = lane_points[0];
         let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
         self.a[k] = p.a;
         self.b[k] = p.b;
@@ -1282,7 +1285,6 @@ fn unused_lane(null_body: u32) -> [PointConstraint; 2] {
         tangent_impulse: 0.0,
         max_normal_impulse: 0.0,
         closing_acceleration: 0.0,
-        in_lcp: false,
         pair_coupling: Some(NormalBlock {
             k11: 0.0,
             k12: 0.0,
@@ -1432,7 +1434,6 @@ mod tests {
             tangent_impulse: n.next(-0.1, 0.1),
             max_normal_impulse: if bounces { 0.0 } else { 0.1 },
             closing_acceleration: n.next(0.0, 10.0),
-            in_lcp: false,
             pair_coupling: None,
         }
     }
@@ -1672,7 +1673,8 @@ mod tests {
     /// `plan` over `points` as one island, from their entries (`inputs_of`).
     fn plan_one_island(plan: &mut PassPlan, points: &[PointConstraint], bodies: &[SoftBody]) {
         let inputs = inputs_of(points, bodies);
-        plan.plan(&[(0, points.len())], &inputs, points, bodies);
+        plan.read(&[(0, points.len(), false)], &inputs);
+        plan.plan(points, bodies);
     }
 
     /// A row of `n` boxes on a fixed floor (body 0), each touching the next: every
@@ -1827,7 +1829,8 @@ mod tests {
         plan.begin_filling();
         for input in inputs_of(&points, &bodies) {
             let (first, count) = (input.first as usize, input.count() as usize);
-            plan.fill_manifold(first, count, &points, &bodies);
+            let manifold: Vec<&PointConstraint> = points[first..first + count].iter().collect();
+            plan.fill_manifold(first, &manifold, &bodies);
         }
         plan_one_island(&mut plan, &points, &bodies);
         assert_eq!(plan.items, kept);
@@ -1850,7 +1853,8 @@ mod tests {
         assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
         let (bodies, points) = row_on_floor(10);
-        plan.plan(&[(0, 38)], &inputs_of(&points, &bodies), &points, &bodies);
+        plan.read(&[(0, 38, false)], &inputs_of(&points, &bodies));
+        plan.plan(&points, &bodies);
         let in_order: Vec<PassItem> = (0..19).map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
     }
