@@ -41,12 +41,6 @@ pub struct BroadPhase {
     extents: Vec<f64>,
 }
 
-/// `Aabb::overlaps` without branches: its four comparisons combined by `&`.
-#[inline(always)]
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    (a.min.x <= b.max.x) & (b.min.x <= a.max.x) & (a.min.y <= b.max.y) & (b.min.y <= a.max.y)
-}
-
 impl BroadPhase {
     /// Candidate pairs `(i, j)`, `i < j`, whose boxes overlap, sorted, skipping pairs that
     /// `wanted` rejects. `boxes[i]` is `None` for bodies that take no part.
@@ -134,7 +128,7 @@ impl BroadPhase {
                     // step, 6.8M this way).
                     let found = (other_cell == cell)
                         & ((xi.max(xj), yi.max(yj)) == cell)
-                        & overlap(&bi, &bj);
+                        & bi.overlaps(&bj);
                     out.push((i, j));
                     out.truncate(out.len() - usize::from(!found));
                 }

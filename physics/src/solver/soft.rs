@@ -507,20 +507,19 @@ impl SoftStepSolver {
         let kept = self
             .plan
             .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+        let rebuild = skipped && (!kept || self.may_bounce);
         #[cfg(test)]
         {
             self.steps_skipping.0 += usize::from(skipped);
-            self.steps_skipping.1 += usize::from(skipped && (!kept || self.may_bounce));
+            self.steps_skipping.1 += usize::from(rebuild);
         }
-        if skipped && (!kept || self.may_bounce) {
+        if rebuild {
             // The plan changed after all, or something bounces (restitution reads every
-            // point): every point is built again, and written.
+            // point): every point is built again, and written. The LCP islands' points
+            // were written already, and the plan's entries come out the same, so the LCP
+            // and the plan's reading stand.
             self.plan.stop_filling();
             self.build_points(bodies, accelerations, contacts, grouped);
-            self.contact_lcp
-                .prepare(&self.bodies, &self.points, &self.contact_islands);
-            self.plan
-                .read(&self.contact_lcp.all_islands, &self.plan_inputs);
         }
         self.contact_grouping = grouping;
         self.plan.plan(&self.points, &self.bodies);

@@ -127,11 +127,10 @@ pub(super) struct PassPlan {
     /// Whether this step's manifolds were written into the kept plan's lanes as they
     /// were built (`begin_filling`), so that `plan` need not fill the batches again.
     filled_while_built: bool,
-    /// Whether the manifolds last `read` are the last plan's.
-    inputs_kept: bool,
-    /// Whether the last step kept the plan before it. One that changed will most likely
-    /// change again (debris in flight: every step of the smash), and its lanes are then
-    /// filled once the new plan is made rather than also while the points are built.
+    /// Whether the last step kept the plan before it (from `read` on, whether this step
+    /// keeps it). One that changed will most likely change again (debris in flight: every
+    /// step of the smash), and its lanes are then filled once the new plan is made rather
+    /// than also while the points are built.
     kept_last_step: bool,
 }
 
@@ -214,14 +213,13 @@ impl PassPlan {
     /// are left out). Whether they are the last plan's: then `plan` keeps it.
     pub fn read(&mut self, islands: &[(usize, usize, bool)], manifolds: &[PlanInput]) -> bool {
         self.read_inputs(islands, manifolds);
-        self.inputs_kept = self.inputs == self.last_inputs;
-        self.inputs_kept
+        self.kept_last_step = self.inputs == self.last_inputs;
+        self.kept_last_step
     }
 
     /// Plans the passes over `points`, for the manifolds last `read`.
     pub fn plan(&mut self, points: &[PointConstraint], bodies: &[SoftBody]) {
         let filled_while_built = std::mem::take(&mut self.filled_while_built);
-        self.kept_last_step = self.inputs_kept;
         if self.kept_last_step {
             // A pile at rest: the same manifolds between the same bodies.
             if !filled_while_built {
