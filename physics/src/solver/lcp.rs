@@ -77,6 +77,8 @@ pub struct LcpSolver {
     dw: Vec<f64>,
     rhs: Vec<f64>,
     previous: Vec<f64>,
+    /// Whether `set`, `clamped` and `factor` are the last solution's (`solve_again`).
+    sets_valid: bool,
 }
 
 /// Regularisation added to `A_CC`'s diagonal (after scaling the diagonal is 1): redundant
@@ -93,7 +95,21 @@ const PGS_TOLERANCE: f64 = 1e-10;
 impl LcpSolver {
     /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
     pub fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+        self.solve_from(p, x, false)
+    }
+
+    /// Solves a problem with the same `A` as the last one this solver solved and another
+    /// `b` (the soft step's passes after its first): the first round starts from the last
+    /// solution's sets and the factor of their `A_CC`, and pivots only if they do not
+    /// solve it.
+    pub fn solve_again(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+        let warm = self.sets_valid && self.b.len() == p.n;
+        self.solve_from(p, x, warm)
+    }
+
+    fn solve_from(&mut self, p: &LcpProblem, x: &mut Vec<f64>, warm: bool) -> LcpStats {
         let n = p.n;
+        self.sets_valid = false;
         x.clear();
         x.resize(n, 0.0);
         let finite = |v: &[f64]| v.iter().all(|z| z.is_finite());
@@ -105,7 +121,11 @@ impl LcpSolver {
                 residual: f64::INFINITY,
             };
         }
-        self.load_scaled(p);
+        if warm {
+            self.load_vectors(p);
+        } else {
+            self.load_scaled(p);
+        }
         let mut stats = LcpStats::default();
         // Gauss–Seidel updates friction bounds row by row already; pivoting needs rounds.
         let has_friction_rows = p
@@ -116,10 +136,13 @@ impl LcpSolver {
         } else {
             1
         };
-        self.x.clear();
-        self.x.resize(n, 0.0);
+        if !warm {
+            // Warm, `x` keeps the last solution (scaled): it bounds the friction rows.
+            self.x.clear();
+            self.x.resize(n, 0.0);
+        }
         let mut method = LcpMethod::Pivoting;
-        let mut pivoted = false;
+        let mut pivoted = warm;
         for _ in 0..rounds {
             self.previous.clone_from(&self.x);
             self.update_friction_bounds(p);
@@ -150,6 +173,9 @@ impl LcpSolver {
         for ((out, scaled), scale) in x.iter_mut().zip(&self.x).zip(&self.scale).take(n) {
             *out = scaled * scale;
         }
+        // The sets and the factor are a solution's (for `solve_again`) only if no round
+        // fell back to Gauss–Seidel.
+        self.sets_valid = pivoted && method == LcpMethod::Pivoting;
         stats.method = method;
         stats.residual = complementarity_residual(p, x);
         stats
@@ -211,6 +237,17 @@ impl LcpSolver {
         true
     }
 
+    /// `b`, `lo` and `hi`, scaled as the last `load_scaled` scaled the matrix.
+    fn load_vectors(&mut self, p: &LcpProblem) {
+        let n = p.n;
+        self.b.clear();
+        self.b.extend((0..n).map(|i| self.scale[i] * p.b[i]));
+        self.lo.clear();
+        self.lo.extend((0..n).map(|i| p.lo[i] / self.scale[i]));
+        self.hi.clear();
+        self.hi.extend((0..n).map(|i| p.hi[i] / self.scale[i]));
+    }
+
     /// Copies the problem scaled by `s_i = 1/√A_ii`: `A' = S A S`, `b' = S b`, `x = S x'`.
     fn load_scaled(&mut self, p: &LcpProblem) {
         let n = p.n;
@@ -225,12 +262,7 @@ impl LcpSolver {
         self.a.clear();
         self.a
             .extend((0..n * n).map(|k| self.scale[k / n] * p.a[k] * self.scale[k % n]));
-        self.b.clear();
-        self.b.extend((0..n).map(|i| self.scale[i] * p.b[i]));
-        self.lo.clear();
-        self.lo.extend((0..n).map(|i| p.lo[i] / self.scale[i]));
-        self.hi.clear();
-        self.hi.extend((0..n).map(|i| p.hi[i] / self.scale[i]));
+        self.load_vectors(p);
     }
 
     /// Friction rows take their bounds from the current normal impulses (in scaled units).

@@ -23,7 +23,8 @@ pub enum IslandMethod {
     Pivoting,
     /// `exact`/`thesis` above the row limit: projected Gauss–Seidel row by row.
     GaussSeidel,
-    /// `soft`: a contact island of very different masses, one LCP per pass.
+    /// `soft`: a small contact island of different masses, one LCP per pass (its normals;
+    /// its friction too where the masses differ 100-fold).
     SoftLcp,
     /// `soft`: contacts point by point (two-point manifolds as a 2 × 2 block).
     SoftPointByPoint,

@@ -1,0 +1,57 @@
+//! How often each contact solver lets bodies sink into each other in random throws
+//! (`physics/tests/support/random_throws.rs` says what a throw is and how it is judged):
+//! the throws past the bound, each with its class, and the count by class.
+//!
+//! `cargo run --release -p pe --example throw_survey -- [solver] [worlds] [seed] [substeps]`
+//! (defaults: soft, 100, 1, and the soft step's default substeps; solvers by
+//! `ContactSolver::name`).
+
+#[path = "../tests/support/random_throws.rs"]
+mod random_throws;
+
+use pe::ContactSolver;
+use random_throws::{BOUND, Class, Numbers, throw};
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let solver = args.first().map_or(Some(ContactSolver::Soft), |name| {
+        ContactSolver::from_name(name)
+    });
+    let Some(solver) = solver else {
+        eprintln!("unknown solver {:?}", args[0]);
+        std::process::exit(2);
+    };
+    let worlds: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(100);
+    let seed: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1);
+    let substeps: Option<usize> = args.get(3).and_then(|s| s.parse().ok());
+    let mut numbers = Numbers(seed);
+    let started = Instant::now();
+    let mut failed = Vec::new();
+    for world in 0..worlds {
+        let outcome = throw(&mut numbers, solver, substeps);
+        if outcome.depth > BOUND {
+            let (a, b) = outcome.masses;
+            println!(
+                "world {world}: {} bodies, {:.2} radii deep at step {}, {:?}, masses {a:.3} and {b:.3} (ratio {:.0})",
+                outcome.bodies,
+                outcome.depth,
+                outcome.step,
+                outcome.class,
+                a.max(b) / a.min(b).max(f64::MIN_POSITIVE),
+            );
+            failed.push(outcome.class);
+        }
+    }
+    let count = |class| failed.iter().filter(|&&c| c == class).count();
+    let substeps = substeps.map_or(String::new(), |n| format!(" ({n} substeps)"));
+    println!(
+        "{}{substeps}: {} of {worlds} worlds deeper than {BOUND} radii (overlapping from the start {}, in one step {}, gradually {}); {:.1} s",
+        solver.name(),
+        failed.len(),
+        count(Class::OverlappingFromStart),
+        count(Class::InOneStep),
+        count(Class::Gradually),
+        started.elapsed().as_secs_f64(),
+    );
+}
