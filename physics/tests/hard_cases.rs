@@ -314,19 +314,7 @@ struct Thrown {
 /// Random convex bodies thrown together in a walled 20 × 20 box for 1,000 steps.
 fn throw_together(bodies: &[RandomBody], solver: ContactSolver) -> Thrown {
     let g = 10.0;
-    let mut w = World::new(Vec2::new(0.0, g));
-    w.settings.contact_solver = solver;
-    w.friction = 0.5;
-    // Floor and walls, each 1 thick, around [-10, 10] × [-20, 0].
-    for (size, at) in [
-        (Vec2::new(22.0, 1.0), Vec2::new(0.0, 0.5)),
-        (Vec2::new(1.0, 22.0), Vec2::new(-10.5, -10.0)),
-        (Vec2::new(1.0, 22.0), Vec2::new(10.5, -10.0)),
-    ] {
-        let shape = ConvexPolygon::rectangle(size.x, size.y).unwrap();
-        w.add_body(BodyDef::new(shape, 0.0).restitution(1.0).at(at, 0.0))
-            .unwrap();
-    }
+    let mut w = random_throws::walled_box(solver);
     let mut smallest = f64::INFINITY;
     let mut weight = 0.0;
     for (i, &(sides, radius, x, y, angle, vx, vy, spin, e)) in bodies.iter().enumerate() {

@@ -58,19 +58,11 @@ pub struct Outcome {
     pub masses: (f64, f64),
 }
 
-/// Random convex bodies in the walled 20 × 20 box of the property test: 2–23 regular
-/// polygons of 3–8 sides, radius 0.2–1.5, random poses, velocities, spins, and
-/// restitution 0, 0.3 or 0.8; friction 0.5, g = 10.
-pub fn random_world(
-    numbers: &mut Numbers,
-    solver: ContactSolver,
-    substeps: Option<usize>,
-) -> (World, f64, usize) {
+/// The walled 20 × 20 box the throws land in: floor and walls 1 thick around
+/// [-10, 10] × [-20, 0], restitution 1; friction 0.5, g = 10.
+pub fn walled_box(solver: ContactSolver) -> World {
     let mut w = World::new(Vec2::new(0.0, 10.0));
     w.settings.contact_solver = solver;
-    if let Some(substeps) = substeps {
-        w.settings.soft_substeps = substeps;
-    }
     w.friction = 0.5;
     for (size, at) in [
         (Vec2::new(22.0, 1.0), Vec2::new(0.0, 0.5)),
@@ -80,6 +72,21 @@ pub fn random_world(
         let shape = ConvexPolygon::rectangle(size.x, size.y).expect("a wall");
         w.add_body(BodyDef::new(shape, 0.0).restitution(1.0).at(at, 0.0))
             .expect("a wall");
+    }
+    w
+}
+
+/// Random convex bodies in the walled box: 2–23 regular polygons of 3–8 sides, radius
+/// 0.2–1.5, random poses, velocities, spins, and restitution 0, 0.3 or 0.8. The world,
+/// the smallest radius and the number of bodies.
+pub fn random_world(
+    numbers: &mut Numbers,
+    solver: ContactSolver,
+    substeps: Option<usize>,
+) -> (World, f64, usize) {
+    let mut w = walled_box(solver);
+    if let Some(substeps) = substeps {
+        w.settings.soft_substeps = substeps;
     }
     let count = 2 + numbers.below(22) as usize;
     let mut smallest = f64::INFINITY;
