@@ -325,3 +325,49 @@ fn mass_ratio_of_a_million_is_solved_exactly() {
     assert!(exact[1] < 0.0);
     assert!((x[0] - 1.0 / light).abs() < 1e-15 && x[1] == 0.0, "{x:?}");
 }
+
+/// `solve_again` (the soft step's passes after the first: the same matrix, another b)
+/// starts from the last solution's sets: the same random problems, each solved, then
+/// solved again with b moved a little (as between passes) and a lot, must meet the LCP
+/// conditions as a fresh solve does, reach the same objective (every solution of a PSD
+/// box LCP does), and take the warm path where b moved little.
+#[test]
+fn solved_again_with_another_b_the_same_matrix_gives_a_fresh_solves_answer() {
+    let mut runner = TestRunner::new_with_rng(
+        Config::default(),
+        TestRng::deterministic_rng(RngAlgorithm::ChaCha),
+    );
+    let strategy = problem(40);
+    let (mut warm, mut fresh) = (LcpSolver::default(), LcpSolver::default());
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    let (mut small_moves, mut reused) = (0, 0);
+    for case in 0..300 {
+        let p = strategy.new_tree(&mut runner).unwrap().current();
+        warm.solve(&p.problem(), &mut x);
+        for (k, size) in [1e-3, 0.5].into_iter().enumerate() {
+            let mut moved = p.clone();
+            for (i, b) in moved.b.iter_mut().enumerate() {
+                *b += size * (((case * 7 + i * 13 + k) % 11) as f64 - 5.0) / 5.0;
+            }
+            let stats = warm.solve_again(&moved.problem(), &mut x);
+            fresh.solve(&moved.problem(), &mut y);
+            let violation = moved.violation(&x);
+            assert!(
+                violation <= 1e-9,
+                "case {case}, move {size}: violation {violation:e}"
+            );
+            let scale = 1.0 + moved.scale(&x) * x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            let (ours, theirs) = (moved.objective(&x), moved.objective(&y));
+            assert!(
+                (ours - theirs).abs() <= 1e-8 * scale,
+                "case {case}, move {size}: objective {ours} against a fresh solve's {theirs}"
+            );
+            if size < 0.1 && stats.method == LcpMethod::Pivoting {
+                small_moves += 1;
+                reused += usize::from(stats.reused_sets > 0);
+            }
+        }
+    }
+    eprintln!("{reused} of {small_moves} small moves solved from the last sets");
+    assert!(reused * 2 >= small_moves, "{reused} of {small_moves}");
+}
