@@ -32,13 +32,15 @@ fn main() {
         let outcome = throw(&mut numbers, solver, substeps);
         if outcome.depth > BOUND {
             let (a, b) = outcome.masses;
+            // A fixed body (a wall, the floor) has no mass here.
+            let ratio = if a.min(b) > 0.0 {
+                format!("ratio {:.0}", a.max(b) / a.min(b))
+            } else {
+                "one fixed".to_owned()
+            };
             println!(
-                "world {world}: {} bodies, {:.2} radii deep at step {}, {:?}, masses {a:.3} and {b:.3} (ratio {:.0})",
-                outcome.bodies,
-                outcome.depth,
-                outcome.step,
-                outcome.class,
-                a.max(b) / a.min(b).max(f64::MIN_POSITIVE),
+                "world {world}: {} bodies, {:.2} radii deep at step {}, {:?}, masses {a:.3} and {b:.3} ({ratio})",
+                outcome.bodies, outcome.depth, outcome.step, outcome.class,
             );
             failed.push(outcome.class);
         }

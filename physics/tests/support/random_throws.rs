@@ -113,6 +113,8 @@ pub fn random_world(
     (w, smallest, count)
 }
 
+/// Throws the next random world (`random_world`), steps it `STEPS` times, and judges its
+/// deepest contact.
 pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usize>) -> Outcome {
     let (mut w, smallest, bodies) = random_world(numbers, solver, substeps);
     let mut overlapping_at_start = HashSet::new();
