@@ -204,13 +204,17 @@ fn brute_force(original: &Owned) -> Option<f64> {
     }
 }
 
-#[test]
-fn a_thousand_random_boxed_lcps_satisfy_bounds_and_complementarity() {
-    // A fixed seed: the same thousand problems every run.
-    let mut runner = TestRunner::new_with_rng(
+/// A fixed seed: the same problems every run.
+fn seeded_runner() -> TestRunner {
+    TestRunner::new_with_rng(
         Config::default(),
         TestRng::deterministic_rng(RngAlgorithm::ChaCha),
-    );
+    )
+}
+
+#[test]
+fn a_thousand_random_boxed_lcps_satisfy_bounds_and_complementarity() {
+    let mut runner = seeded_runner();
     let strategy = problem(60);
     let mut solver = LcpSolver::default();
     let mut x = Vec::new();
@@ -333,10 +337,7 @@ fn mass_ratio_of_a_million_is_solved_exactly() {
 /// box LCP does), and take the warm path where b moved little.
 #[test]
 fn solved_again_with_another_b_the_same_matrix_gives_a_fresh_solves_answer() {
-    let mut runner = TestRunner::new_with_rng(
-        Config::default(),
-        TestRng::deterministic_rng(RngAlgorithm::ChaCha),
-    );
+    let mut runner = seeded_runner();
     let strategy = problem(40);
     let (mut warm, mut fresh) = (LcpSolver::default(), LcpSolver::default());
     let (mut x, mut y) = (Vec::new(), Vec::new());
