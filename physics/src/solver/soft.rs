@@ -212,25 +212,24 @@ impl NormalBlock {
         (a, b): (&SoftBody, &SoftBody),
         (p, q): (&PointConstraint, &PointConstraint),
     ) -> Option<Self> {
-        let ((a1, b1), (a2, b2)) = (p.levers.normal, q.levers.normal);
+        let (l1, l2) = (p.levers.normal, q.levers.normal);
         // Multiplied out again rather than taken as 1 / normal_mass, and the inverse
         // from one reciprocal: divisions were the slowest part of building the points.
         let m = a.inv_mass + b.inv_mass;
-        let k11 = m + a.inv_inertia * a1 * a1 + b.inv_inertia * b1 * b1;
-        let k12 = m + a.inv_inertia * a1 * a2 + b.inv_inertia * b1 * b2;
-        let k22 = m + a.inv_inertia * a2 * a2 + b.inv_inertia * b2 * b2;
+        let inertias = (a.inv_inertia, b.inv_inertia);
+        let k11 = row_coupling(m, inertias, l1, l1);
+        let k12 = row_coupling(m, inertias, l1, l2);
+        let k22 = row_coupling(m, inertias, l2, l2);
         let det = k11 * k22 - k12 * k12;
-        (p.normal_mass > 0.0 && q.normal_mass > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det).then(
-            || {
-                let inv_det = 1.0 / det;
-                Self {
-                    k11,
-                    k12,
-                    k22,
-                    inverse: (k22 * inv_det, -k12 * inv_det, k11 * inv_det),
-                }
-            },
-        )
+        (k11 > 0.0 && k22 > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det).then(|| {
+            let inv_det = 1.0 / det;
+            Self {
+                k11,
+                k12,
+                k22,
+                inverse: (k22 * inv_det, -k12 * inv_det, k11 * inv_det),
+            }
+        })
     }
 }
 
@@ -247,6 +246,19 @@ impl PointLevers {
     fn tangent(&self) -> (f64, f64) {
         self.reach
     }
+}
+
+/// J M⁻¹ Jᵀ of two rows along one direction between the same two bodies: `inv_masses` the
+/// bodies' summed inverse masses, `inertias` their inverse inertias, and each row's levers
+/// (`r × n` on A and on B). With one row twice, the inverse of its effective mass.
+#[inline(always)]
+fn row_coupling(
+    inv_masses: f64,
+    (ia, ib): (f64, f64),
+    (a1, b1): (f64, f64),
+    (a2, b2): (f64, f64),
+) -> f64 {
+    inv_masses + ia * a1 * a2 + ib * b1 * b2
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
@@ -655,8 +667,9 @@ impl SoftStepSolver {
                 reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
             };
             // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
-            let mass = |(la, lb): (f64, f64)| {
-                let k = a.inv_mass + b.inv_mass + a.inv_inertia * la * la + b.inv_inertia * lb * lb;
+            let mass = |levers: (f64, f64)| {
+                let inertias = (a.inv_inertia, b.inv_inertia);
+                let k = row_coupling(a.inv_mass + b.inv_mass, inertias, levers, levers);
                 if k > 0.0 { 1.0 / k } else { 0.0 }
             };
             let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
@@ -1479,9 +1492,9 @@ fn solve_joint(
 /// load down through light bodies slowly: a body rolling at 4 m/s over one 13 times
 /// lighter on the floor went 1.4 smallest radii into it. The coupled solve does both at
 /// once. Each pass after the step's first starts from the last pass's sets: where they
-/// still hold, it solves one triangular system instead of pivoting. Measured with `physics/examples/throw_survey.rs`
-/// (1,600 random throws, the share with a contact deeper than a fifth of the smallest
-/// radius after 2 s): point by point 12.9%; normals in an LCP from 10-fold masses 9.9%, in
+/// still hold, it solves one triangular system instead of pivoting. Measured with
+/// `physics/examples/throw_survey.rs` (1,600 random throws, the share with a contact
+/// deeper than a fifth of the smallest radius after 2 s): point by point 12.9%; normals in an LCP from 10-fold masses 9.9%, in
 /// a quarter more time; from 4-fold or 2-fold 10.7%, in half as much again; islands of up
 /// to 32 points 10.6%, in twice the time. With friction in every small island's LCP too,
 /// 1,000 steps of the random piles of the hard-case tests (17–21 polygons) took 0.14–6.3 s

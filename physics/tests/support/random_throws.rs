@@ -14,17 +14,17 @@
 use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Vec2, World};
 use std::collections::{HashMap, HashSet};
 
-pub const H: f64 = 1.0 / 60.0;
-pub const STEPS: usize = 1000;
+const H: f64 = 1.0 / 60.0;
+const STEPS: usize = 1000;
 /// Deepest contacts are judged from this step on (2 s), as in the property test.
-pub const JUDGED_FROM: usize = 120;
+const JUDGED_FROM: usize = 120;
 pub const BOUND: f64 = 0.2;
 
 /// SplitMix64: enough randomness for reproducible worlds without a dependency.
 pub struct Numbers(pub u64);
 
 impl Numbers {
-    pub fn next(&mut self) -> u64 {
+    fn next(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -32,11 +32,11 @@ impl Numbers {
         z ^ (z >> 31)
     }
 
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    pub fn below(&mut self, n: u64) -> u64 {
+    fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
 }
@@ -79,7 +79,7 @@ pub fn walled_box(solver: ContactSolver) -> World {
 /// Random convex bodies in the walled box: 2–23 regular polygons of 3–8 sides, radius
 /// 0.2–1.5, random poses, velocities, spins, and restitution 0, 0.3 or 0.8. The world,
 /// the smallest radius and the number of bodies.
-pub fn random_world(
+fn random_world(
     numbers: &mut Numbers,
     solver: ContactSolver,
     substeps: Option<usize>,
