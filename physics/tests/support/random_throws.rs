@@ -1,24 +1,49 @@
 //! Random throws: convex bodies thrown together in a walled box (the worlds of the
-//! hard-case property test), each stepped 1,000 times, and the deepest contact after the
+//! hard-case property test), each stepped 1,000 times, and the deepest overlap after the
 //! first 2 s over the smallest body's radius. A throw sinks past `BOUND` (the property
-//! test's bound), and is put in one of three classes by its deepest contact:
+//! test's bound), and is put in one of three classes by its deepest overlap:
 //!
 //! - *overlapping from the start*: the pair already overlapped by more than the bound in
 //!   the first steps (random starts may overlap; some solvers take longer to part them);
 //! - *in one step*: the pair was within the bound (or apart) one step before: an impact;
 //! - *gradually*: the pair sank past the bound over several steps.
 //!
-//! Shared by `physics/examples/throw_survey.rs` (the survey) and
-//! `physics/tests/hard_cases.rs` (its test).
+//! The worlds are described apart from any engine (`Throw`), and judged from the bodies'
+//! poses after each step by pe's separating-axis test (`Judge`), so that other engines'
+//! runs of the same throws are judged by the same code.
+//!
+//! Shared by `physics/examples/throw_survey.rs` (the survey), `physics/tests/hard_cases.rs`
+//! (its test) and the benchmark's `throws` (`bench/src/throws.rs`: pe, rapier2d and
+//! Box2D v3 on the same throws).
 
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Vec2, World};
+// Each user takes what it needs of this file.
+#![allow(dead_code)]
+
+use pe::collide::{WorldPolygon, collide_polygons};
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Rot, Vec2, World};
 use std::collections::{HashMap, HashSet};
+use std::time::{Duration, Instant};
 
-const H: f64 = 1.0 / 60.0;
-const STEPS: usize = 1000;
-/// Deepest contacts are judged from this step on (2 s), as in the property test.
+pub const H: f64 = 1.0 / 60.0;
+pub const STEPS: usize = 1000;
+/// Deepest overlaps are judged from this step on (2 s), as in the property test.
 const JUDGED_FROM: usize = 120;
 pub const BOUND: f64 = 0.2;
+/// Along +y: pe's y points down.
+pub const GRAVITY: f64 = 10.0;
+/// Every contact's friction coefficient.
+pub const FRICTION: f64 = 0.5;
+/// The thrown bodies' density.
+pub const DENSITY: f64 = 1.0;
+/// The fixed floor and walls (size, centre) of a 20 × 20 box around [-10, 10] × [-20, 0],
+/// 1 thick. Their restitution is 1, and a pair takes the smaller of its two bodies'
+/// (pe's rule), so a body bounces off them with its own.
+pub const WALLS: [((f64, f64), (f64, f64)); 3] = [
+    ((22.0, 1.0), (0.0, 0.5)),
+    ((1.0, 22.0), (-10.5, -10.0)),
+    ((1.0, 22.0), (10.5, -10.0)),
+];
+pub const WALL_RESTITUTION: f64 = 1.0;
 
 /// SplitMix64: enough randomness for reproducible worlds without a dependency.
 pub struct Numbers(pub u64);
@@ -41,6 +66,97 @@ impl Numbers {
     }
 }
 
+/// One thrown body: a regular polygon centred on its position.
+#[derive(Debug, Clone)]
+pub struct ThrownBody {
+    pub shape: ConvexPolygon,
+    pub radius: f64,
+    pub at: Vec2,
+    pub angle: f64,
+    pub velocity: Vec2,
+    pub spin: f64,
+    pub restitution: f64,
+}
+
+impl ThrownBody {
+    pub fn mass(&self) -> f64 {
+        DENSITY * self.shape.mass_properties().area
+    }
+}
+
+/// A random world: 2–23 regular polygons of 3–8 sides, radius 0.2–1.5, random poses,
+/// velocities, spins, and restitution 0, 0.3 or 0.8, above the floor of the walled box.
+pub struct Throw {
+    pub bodies: Vec<ThrownBody>,
+    pub smallest: f64,
+}
+
+impl Throw {
+    pub fn random(numbers: &mut Numbers) -> Self {
+        let count = 2 + numbers.below(22) as usize;
+        let bodies: Vec<ThrownBody> = (0..count)
+            .map(|i| {
+                let sides = 3 + numbers.below(6) as usize;
+                let radius = numbers.uniform(0.2, 1.5);
+                let at = Vec2::new(
+                    numbers.uniform(-8.0, 8.0),
+                    numbers.uniform(-12.0, -1.0) - 0.01 * i as f64,
+                );
+                ThrownBody {
+                    shape: ConvexPolygon::regular(sides, radius).expect("a regular polygon"),
+                    radius,
+                    at,
+                    angle: numbers.uniform(0.0, 6.3),
+                    velocity: Vec2::new(numbers.uniform(-5.0, 5.0), numbers.uniform(-5.0, 5.0)),
+                    spin: numbers.uniform(-3.0, 3.0),
+                    restitution: [0.0, 0.3, 0.8][numbers.below(3) as usize],
+                }
+            })
+            .collect();
+        let smallest = bodies
+            .iter()
+            .map(|b| b.radius)
+            .fold(f64::INFINITY, f64::min);
+        Self { bodies, smallest }
+    }
+
+    /// The throw as a pe world; the walls are bodies 0–2, the thrown ones follow in order.
+    /// Its length scale is the median radius, as the app gives a scene (`sim`): a typical
+    /// body's size, as the setting means, and near the 1 m the peers' defaults assume.
+    pub fn pe_world(&self, solver: ContactSolver, substeps: Option<usize>) -> World {
+        let mut w = walled_box(solver);
+        if let Some(substeps) = substeps {
+            w.settings.soft_substeps = substeps;
+        }
+        for body in &self.bodies {
+            let def = BodyDef::new(body.shape.clone(), DENSITY)
+                .restitution(body.restitution)
+                .at(body.at, body.angle)
+                .velocity(body.velocity, body.spin);
+            w.add_body(def).expect("a random body");
+        }
+        w.settings.length_scale = w.median_body_radius().expect("thrown bodies");
+        w
+    }
+}
+
+/// The walled box alone (`WALLS`), under `solver`.
+pub fn walled_box(solver: ContactSolver) -> World {
+    let mut w = World::new(Vec2::new(0.0, GRAVITY));
+    w.settings.contact_solver = solver;
+    w.friction = FRICTION;
+    for ((width, height), (x, y)) in WALLS {
+        let shape = ConvexPolygon::rectangle(width, height).expect("a wall");
+        w.add_body(
+            BodyDef::new(shape, 0.0)
+                .restitution(WALL_RESTITUTION)
+                .at(Vec2::new(x, y), 0.0),
+        )
+        .expect("a wall");
+    }
+    w
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Class {
     OverlappingFromStart,
@@ -50,107 +166,110 @@ pub enum Class {
 
 pub struct Outcome {
     pub bodies: usize,
-    /// Deepest contact after `JUDGED_FROM`, over the smallest radius, its step, its class
-    /// and the two bodies' masses.
+    /// Deepest overlap after `JUDGED_FROM`, over the smallest radius, its step, its class
+    /// and the two bodies' masses (0 for a wall).
     pub depth: f64,
     pub step: usize,
     pub class: Class,
     pub masses: (f64, f64),
 }
 
-/// The walled 20 × 20 box the throws land in: floor and walls 1 thick around
-/// [-10, 10] × [-20, 0], restitution 1; friction 0.5, g = 10.
-pub fn walled_box(solver: ContactSolver) -> World {
-    let mut w = World::new(Vec2::new(0.0, 10.0));
-    w.settings.contact_solver = solver;
-    w.friction = 0.5;
-    for (size, at) in [
-        (Vec2::new(22.0, 1.0), Vec2::new(0.0, 0.5)),
-        (Vec2::new(1.0, 22.0), Vec2::new(-10.5, -10.0)),
-        (Vec2::new(1.0, 22.0), Vec2::new(10.5, -10.0)),
-    ] {
-        let shape = ConvexPolygon::rectangle(size.x, size.y).expect("a wall");
-        w.add_body(BodyDef::new(shape, 0.0).restitution(1.0).at(at, 0.0))
-            .expect("a wall");
+impl Outcome {
+    pub fn sank(&self) -> bool {
+        self.depth > BOUND
     }
-    w
 }
 
-/// Random convex bodies in the walled box: 2–23 regular polygons of 3–8 sides, radius
-/// 0.2–1.5, random poses, velocities, spins, and restitution 0, 0.3 or 0.8. The world,
-/// the smallest radius and the number of bodies.
-fn random_world(
-    numbers: &mut Numbers,
-    solver: ContactSolver,
-    substeps: Option<usize>,
-) -> (World, f64, usize) {
-    let mut w = walled_box(solver);
-    if let Some(substeps) = substeps {
-        w.settings.soft_substeps = substeps;
-    }
-    let count = 2 + numbers.below(22) as usize;
-    let mut smallest = f64::INFINITY;
-    for i in 0..count {
-        let sides = 3 + numbers.below(6) as usize;
-        let radius = numbers.uniform(0.2, 1.5);
-        let at = Vec2::new(
-            numbers.uniform(-8.0, 8.0),
-            numbers.uniform(-12.0, -1.0) - 0.01 * i as f64,
-        );
-        let angle = numbers.uniform(0.0, 6.3);
-        let velocity = Vec2::new(numbers.uniform(-5.0, 5.0), numbers.uniform(-5.0, 5.0));
-        let spin = numbers.uniform(-3.0, 3.0);
-        let restitution = [0.0, 0.3, 0.8][numbers.below(3) as usize];
-        let shape = ConvexPolygon::regular(sides, radius).expect("a regular polygon");
-        let def = BodyDef::new(shape, 1.0)
-            .restitution(restitution)
-            .at(at, angle)
-            .velocity(velocity, spin);
-        w.add_body(def).expect("a random body");
-        smallest = smallest.min(radius);
-    }
-    w.settings.length_scale = smallest;
-    (w, smallest, count)
+/// Judges a throw from its bodies' poses after each step: every pair's deepest overlap by
+/// pe's separating-axis test and clipping (the depth pe's contacts report).
+pub struct Judge {
+    smallest: f64,
+    /// The walls' polygons, then the thrown bodies' at their last poses.
+    polygons: Vec<WorldPolygon>,
+    /// The thrown bodies' vertices in their own frames, and their masses.
+    shapes: Vec<(Vec<Vec2>, f64)>,
+    overlapping_at_start: HashSet<(usize, usize)>,
+    /// Each overlapping pair's deepest overlap, over the smallest radius, at the step
+    /// before, and at this one in the pairs' order (so that ties go the same way each run).
+    before: HashMap<(usize, usize), f64>,
+    now: Vec<((usize, usize), f64)>,
+    outcome: Outcome,
 }
 
-/// Throws the next random world (`random_world`), steps it `STEPS` times, and judges its
-/// deepest contact.
-pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usize>) -> Outcome {
-    let (mut w, smallest, bodies) = random_world(numbers, solver, substeps);
-    let mut overlapping_at_start = HashSet::new();
-    let mut outcome = Outcome {
-        bodies,
-        depth: 0.0,
-        step: 0,
-        class: Class::Gradually,
-        masses: (0.0, 0.0),
-    };
-    // Each pair's deepest contact at the step before, over the smallest radius.
-    let (mut before, mut now) = (HashMap::new(), HashMap::new());
-    for step in 0..STEPS {
-        w.step(H);
-        std::mem::swap(&mut before, &mut now);
-        now.clear();
-        for c in w.contacts() {
-            let deepest = now.entry((c.body_a, c.body_b)).or_insert(f64::NEG_INFINITY);
-            *deepest = f64::max(*deepest, c.depth / smallest);
+impl Judge {
+    pub fn new(throw: &Throw) -> Self {
+        let walls = WALLS.iter().map(|&((width, height), (x, y))| {
+            let mut polygon = WorldPolygon::default();
+            let shape = ConvexPolygon::rectangle(width, height).expect("a wall");
+            let centre = Vec2::new(x, y);
+            polygon.set_vertices(shape.vertices().iter().map(|v| v + centre));
+            polygon
+        });
+        Self {
+            smallest: throw.smallest,
+            polygons: walls.collect(),
+            shapes: throw
+                .bodies
+                .iter()
+                .map(|b| (b.shape.vertices().to_vec(), b.mass()))
+                .collect(),
+            overlapping_at_start: HashSet::new(),
+            before: HashMap::new(),
+            now: Vec::new(),
+            outcome: Outcome {
+                bodies: throw.bodies.len(),
+                depth: 0.0,
+                step: 0,
+                class: Class::Gradually,
+                masses: (0.0, 0.0),
+            },
         }
-        for c in w.contacts() {
-            let depth = c.depth / smallest;
-            if step < 3 && depth > BOUND {
-                overlapping_at_start.insert((c.body_a, c.body_b));
+    }
+
+    /// After step `step` (from 0), with each thrown body's pose (position, angle) in order.
+    pub fn after_step(&mut self, step: usize, poses: impl Iterator<Item = (Vec2, f64)>) {
+        self.polygons.truncate(WALLS.len());
+        for ((vertices, _), (at, angle)) in self.shapes.iter().zip(poses) {
+            let turn = Rot::new(angle);
+            let mut polygon = WorldPolygon::default();
+            polygon.set_vertices(vertices.iter().map(|&v| at + turn.apply(v)));
+            self.polygons.push(polygon);
+        }
+        self.before.clear();
+        self.before.extend(self.now.drain(..));
+        let bounds: Vec<_> = self.polygons.iter().map(WorldPolygon::aabb).collect();
+        let tie_tolerance = 0.001 * self.smallest;
+        for j in WALLS.len()..self.polygons.len() {
+            for i in 0..j {
+                if !bounds[i].overlaps(&bounds[j]) {
+                    continue;
+                }
+                let manifold = collide_polygons(
+                    (BodyHandle(i as u32), &self.polygons[i]),
+                    (BodyHandle(j as u32), &self.polygons[j]),
+                    0.0,
+                    tie_tolerance,
+                );
+                let deepest = manifold.map_or(0.0, |m| {
+                    m.points().iter().map(|p| p.depth).fold(0.0, f64::max)
+                });
+                if deepest > 0.0 {
+                    self.now.push(((i, j), deepest / self.smallest));
+                }
             }
-            if step >= JUDGED_FROM && depth > outcome.depth {
-                let mass = |i: u32| w.body(BodyHandle(i)).map_or(0.0, |b| b.mass());
-                outcome.depth = depth;
-                outcome.step = step;
-                outcome.masses = (mass(c.body_a), mass(c.body_b));
-                outcome.class = if overlapping_at_start.contains(&(c.body_a, c.body_b)) {
+        }
+        for &(pair, depth) in &self.now {
+            if step < 3 && depth > BOUND {
+                self.overlapping_at_start.insert(pair);
+            }
+            if step >= JUDGED_FROM && depth > self.outcome.depth {
+                let mass = |k: usize| k.checked_sub(WALLS.len()).map_or(0.0, |k| self.shapes[k].1);
+                self.outcome.depth = depth;
+                self.outcome.step = step;
+                self.outcome.masses = (mass(pair.0), mass(pair.1));
+                self.outcome.class = if self.overlapping_at_start.contains(&pair) {
                     Class::OverlappingFromStart
-                } else if before
-                    .get(&(c.body_a, c.body_b))
-                    .is_none_or(|&d| d <= BOUND)
-                {
+                } else if self.before.get(&pair).is_none_or(|&d| d <= BOUND) {
                     Class::InOneStep
                 } else {
                     Class::Gradually
@@ -158,5 +277,40 @@ pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usiz
             }
         }
     }
-    outcome
+
+    pub fn outcome(self) -> Outcome {
+        self.outcome
+    }
+}
+
+/// Throws the next random world under pe's `solver` (`run_in_pe`).
+pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usize>) -> Outcome {
+    let mut stepping = Duration::ZERO;
+    run_in_pe(&Throw::random(numbers), solver, substeps, &mut stepping)
+}
+
+/// Steps `throw` in pe `STEPS` times, and judges it; adds the time spent stepping (not
+/// judging) to `stepping`.
+pub fn run_in_pe(
+    throw: &Throw,
+    solver: ContactSolver,
+    substeps: Option<usize>,
+    stepping: &mut Duration,
+) -> Outcome {
+    let mut w = throw.pe_world(solver, substeps);
+    let mut judge = Judge::new(throw);
+    let thrown: Vec<BodyHandle> = (0..throw.bodies.len())
+        .map(|k| BodyHandle((WALLS.len() + k) as u32))
+        .collect();
+    for step in 0..STEPS {
+        let started = Instant::now();
+        w.step(H);
+        *stepping += started.elapsed();
+        let pose = |&h: &BodyHandle| {
+            let b = w.body(h).expect("a thrown body");
+            (b.origin(), b.angle)
+        };
+        judge.after_step(step, thrown.iter().map(pose));
+    }
+    judge.outcome()
 }
