@@ -2,9 +2,10 @@
 //! scenes with known answers, and writes the results as Markdown to docs/bench/results.md;
 //! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots; with
 //! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
-//! outcome.
+//! outcome; with `throws [count] [seed] [list]`, the random throws alone (`throws.rs`),
+//! listing each that sinks with `list`.
 //!
-//! Run with `cargo run --release [-- sweep | -- pe smash soft]` inside bench/.
+//! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws]` inside bench/.
 
 mod box2d_scenes;
 mod harness;
@@ -13,6 +14,7 @@ mod rapier_scenes;
 mod robots;
 mod scene;
 mod sweep;
+mod throws;
 
 use harness::{RUN_BUDGET, TURN_STEPS, Timing, WARMUP_STEPS, WARMUP_WALL, interleaved};
 use pe::ContactSolver;
@@ -126,6 +128,16 @@ fn main() {
         run_pile_with_peers();
         return;
     }
+    if std::env::args().nth(1).as_deref() == Some("throws") {
+        let arg = |k: usize| std::env::args().nth(k).and_then(|a| a.parse().ok());
+        let count = arg(2).map_or(throws::THROWS, |c: u64| c as usize);
+        let seed = arg(3).unwrap_or(throws::SEED);
+        let list = std::env::args().any(|a| a == "list");
+        let mut md = String::new();
+        write_throws(&mut md, &throws::run(count, seed, list), seed);
+        println!("{md}");
+        return;
+    }
     let mut rows = Vec::new();
     for spec in &PYRAMIDS {
         rows.push(run_row(
@@ -176,11 +188,13 @@ fn main() {
     let piles = pile_rows();
     let narrow = narrow_phase_rows();
     let robot_rows = robots::run();
+    let throw_rows = throws::run(throws::THROWS, throws::SEED, false);
     let report = report(
         &rows,
         &piles,
         &narrow,
         &robot_rows,
+        &throw_rows,
         started.elapsed(),
         &load,
     );
@@ -485,6 +499,7 @@ fn report(
     piles: &[(&str, Vec<PileRound>)],
     narrow: &[NarrowRow],
     robot_rows: &[robots::RobotRow],
+    throw_rows: &[throws::ThrowsRow],
     elapsed: Duration,
     load: &str,
 ) -> String {
@@ -678,7 +693,52 @@ fn report(
         }
         let _ = writeln!(w);
     }
+    write_throws(w, throw_rows, throws::SEED);
     md
+}
+
+/// The random throws' section: each engine's throws that sank, by class.
+fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
+    let Some(first) = rows.first() else {
+        return;
+    };
+    let _ = writeln!(w, "\n## Random throws\n");
+    let _ = writeln!(
+        w,
+        "The worlds of pe's hard-case tests (`physics/tests/support/random_throws.rs`): 2–23 \
+         regular polygons (3–8 sides, radius 0.2–1.5 m, density 1; random poses, velocities \
+         up to 5 m/s, spins up to 3 rad/s, restitution 0, 0.3 or 0.8) thrown into a walled \
+         box 20 m wide, friction 0.5, g = 10 m/s², 1,000 steps of 1/60 s; the same {} \
+         worlds (seed {seed}) in every engine, a pair taking the smaller restitution in \
+         each. A throw sinks when, after its first 2 s, two bodies overlap by more than a \
+         fifth of its smallest body's radius, by pe's separating-axis test on each \
+         engine's poses after every step; it is counted as overlapping from the start (the \
+         pair already did in the first 3 steps), in one step (an impact: within the bound \
+         the step before) or gradually. pe's length scale is the median radius (as the app \
+         sets a scene's); the peers run at their defaults (1 m). The time is the stepping alone, all throws together.\n",
+        first.throws
+    );
+    let columns = [
+        "throws that sink",
+        "from the start / in one step / gradually",
+        "deepest overlap (smallest radii)",
+        "time stepping",
+    ]
+    .map(String::from);
+    let _ = writeln!(w, "{}", table_head(&["engine"], &columns, "---:"));
+    for r in rows {
+        let [start, impact, gradual] = r.sunk;
+        let _ = writeln!(
+            w,
+            "| {} | {} of {} ({:.1}%) | {start} / {impact} / {gradual} | {:.2} | {:.1} s |",
+            r.engine,
+            r.sunk_total(),
+            r.throws,
+            100.0 * r.sunk_total() as f64 / r.throws as f64,
+            r.deepest,
+            r.stepping.as_secs_f64()
+        );
+    }
 }
 
 /// A Markdown table's header row and rule: the `lead` columns left-aligned, then

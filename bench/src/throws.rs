@@ -1,0 +1,216 @@
+//! Random throws in every engine: the same worlds (`Throw`, from pe's hard-case tests) in
+//! pe, rapier2d and Box2D v3, each judged from its bodies' poses after every step by the
+//! same separating-axis test (`Judge`): how often a throw sinks past a fifth of the
+//! smallest radius, and how.
+
+#[path = "../../physics/tests/support/random_throws.rs"]
+mod random_throws;
+
+use crate::{box2d_scenes, rapier_scenes};
+use pe::{ContactSolver, Vec2};
+use random_throws::{
+    Class, DENSITY, FRICTION, GRAVITY, H, Judge, Numbers, Outcome, STEPS, Throw, WALL_RESTITUTION,
+    WALLS, run_in_pe,
+};
+use std::time::{Duration, Instant};
+
+/// The main run's throws and their seed.
+pub const THROWS: usize = 200;
+pub const SEED: u64 = 1;
+
+/// The pe solvers thrown (`exact` and `auto` take minutes for a few hundred throws).
+const PE_SOLVERS: [ContactSolver; 2] = [ContactSolver::Soft, ContactSolver::Thesis];
+
+/// One engine's throws.
+pub struct ThrowsRow {
+    pub engine: String,
+    pub throws: usize,
+    /// The throws that sank, by class: from the start, in one step, gradually.
+    pub sunk: [usize; 3],
+    /// The deepest overlap of all, over the smallest radius.
+    pub deepest: f64,
+    /// The time spent stepping (not judging), all throws together.
+    pub stepping: Duration,
+}
+
+impl ThrowsRow {
+    pub fn sunk_total(&self) -> usize {
+        self.sunk.iter().sum()
+    }
+}
+
+/// One engine's run of a throw, adding its stepping time to the second argument.
+type ThrowRun = Box<dyn Fn(&Throw, &mut Duration) -> Outcome>;
+
+/// `throws` random worlds from `seed` in each engine; with `list`, each throw that sinks
+/// on stderr.
+pub fn run(throws: usize, seed: u64, list: bool) -> Vec<ThrowsRow> {
+    let pe_runs = PE_SOLVERS.map(|solver| {
+        let engine = format!("pe {}", solver.name());
+        (
+            engine,
+            Box::new(move |t: &Throw, stepping: &mut Duration| run_in_pe(t, solver, None, stepping))
+                as ThrowRun,
+        )
+    });
+    let peers: [(String, ThrowRun); 2] = [
+        ("rapier2d".into(), Box::new(run_in_rapier)),
+        ("Box2D v3".into(), Box::new(run_in_box2d)),
+    ];
+    pe_runs
+        .into_iter()
+        .chain(peers)
+        .map(|(engine, run)| {
+            let started = Instant::now();
+            eprint!("random throws: {throws} in {engine}…");
+            let mut numbers = Numbers(seed);
+            let mut row = ThrowsRow {
+                engine,
+                throws,
+                sunk: [0; 3],
+                deepest: 0.0,
+                stepping: Duration::ZERO,
+            };
+            for k in 0..throws {
+                let outcome = run(&Throw::random(&mut numbers), &mut row.stepping);
+                if list && outcome.sank() {
+                    let (a, b) = outcome.masses;
+                    eprint!(
+                        "\n  world {k}: {:.2} radii deep at step {}, {:?}, masses {a:.3} and {b:.3}",
+                        outcome.depth, outcome.step, outcome.class
+                    );
+                }
+                row.deepest = row.deepest.max(outcome.depth);
+                if outcome.sank() {
+                    row.sunk[match outcome.class {
+                        Class::OverlappingFromStart => 0,
+                        Class::InOneStep => 1,
+                        Class::Gradually => 2,
+                    }] += 1;
+                }
+            }
+            eprintln!(" {:.1} s", started.elapsed().as_secs_f64());
+            row
+        })
+        .collect()
+}
+
+fn run_in_rapier(throw: &Throw, stepping: &mut Duration) -> Outcome {
+    // The prelude's `Vec2` is rapier's: pe's is named in full here.
+    use rapier2d::prelude::*;
+    let v = |p: pe::Vec2| Vector::new(p.x as Real, p.y as Real);
+    let mut w = PhysicsWorld::new();
+    // pe's y points down: gravity along +y, as in the throw.
+    w.gravity = Vector::new(0.0, GRAVITY as Real);
+    w.integration_parameters.dt = H as Real;
+    w.integration_parameters.num_solver_iterations = rapier_scenes::ITERATIONS;
+    // pe's rule for a pair's restitution: the smaller one. Friction: every one is the same.
+    let surface = |c: ColliderBuilder, restitution: f64| {
+        c.friction(FRICTION as Real)
+            .restitution(restitution as Real)
+            .restitution_combine_rule(CoefficientCombineRule::Min)
+    };
+    for ((width, height), (x, y)) in WALLS {
+        let body = RigidBodyBuilder::fixed().translation(v(pe::Vec2::new(x, y)));
+        let shape = ColliderBuilder::cuboid(0.5 * width as Real, 0.5 * height as Real);
+        w.insert(body, surface(shape, WALL_RESTITUTION));
+    }
+    let bodies: Vec<RigidBodyHandle> = throw
+        .bodies
+        .iter()
+        .map(|b| {
+            let body = RigidBodyBuilder::dynamic()
+                .translation(v(b.at))
+                .rotation(b.angle as Real)
+                .linvel(v(b.velocity))
+                .angvel(b.spin as Real)
+                .can_sleep(false);
+            let points: Vec<Vector> = b.shape.vertices().iter().map(|&p| v(p)).collect();
+            let shape = ColliderBuilder::convex_hull(&points)
+                .expect("a regular polygon")
+                .density(DENSITY as Real);
+            w.insert(body, surface(shape, b.restitution)).0
+        })
+        .collect();
+    let mut judge = Judge::new(throw);
+    for step in 0..STEPS {
+        let started = Instant::now();
+        w.step();
+        *stepping += started.elapsed();
+        judge.after_step(
+            step,
+            bodies.iter().map(|&h| {
+                let b = &w.bodies[h];
+                let t = b.translation();
+                let at = pe::Vec2::new(f64::from(t.x), f64::from(t.y));
+                (at, f64::from(b.rotation().angle()))
+            }),
+        );
+    }
+    judge.outcome()
+}
+
+fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
+    use boxdd::{BodyBuilder, BodyType, ShapeDef, SurfaceMaterial, World, WorldDef};
+    let v = |p: Vec2| boxdd::Vec2::new(p.x as f32, p.y as f32);
+    let def = WorldDef::builder()
+        .gravity([0.0, GRAVITY as f32])
+        .enable_sleep(false)
+        .build();
+    let mut w = World::new(def).expect("a valid world definition");
+    // pe's rule for a pair's restitution, the smaller one (Box2D's own takes the larger).
+    w.set_restitution_callback(|a, b| a.coefficient.min(b.coefficient));
+    let shape_def = |restitution: f64, density: f64| {
+        let material = SurfaceMaterial::default()
+            .with_friction(FRICTION as f32)
+            .with_restitution(restitution as f32);
+        ShapeDef::builder()
+            .material(material)
+            .density(density as f32)
+            .build()
+    };
+    for ((width, height), (x, y)) in WALLS {
+        let body = BodyBuilder::new()
+            .body_type(BodyType::Static)
+            .position(v(Vec2::new(x, y)))
+            .build();
+        let body = w.create_body_id(body);
+        let polygon = boxdd::shapes::box_polygon(0.5 * width as f32, 0.5 * height as f32);
+        w.create_polygon_shape_for(body, &shape_def(WALL_RESTITUTION, 0.0), &polygon);
+    }
+    let bodies: Vec<_> = throw
+        .bodies
+        .iter()
+        .map(|b| {
+            let def = BodyBuilder::new()
+                .body_type(BodyType::Dynamic)
+                .position(v(b.at))
+                .angle(b.angle as f32)
+                .linear_velocity(v(b.velocity))
+                .angular_velocity(b.spin as f32)
+                .enable_sleep(false)
+                .build();
+            let body = w.create_body_id(def);
+            let points = b.shape.vertices().iter().map(|&p| v(p));
+            let polygon =
+                boxdd::shapes::polygon_from_points(points, 0.0).expect("a regular polygon");
+            w.create_polygon_shape_for(body, &shape_def(b.restitution, DENSITY), &polygon);
+            body
+        })
+        .collect();
+    let mut judge = Judge::new(throw);
+    for step in 0..STEPS {
+        let started = Instant::now();
+        w.step(H as f32, box2d_scenes::SUBSTEPS);
+        *stepping += started.elapsed();
+        judge.after_step(
+            step,
+            bodies.iter().map(|&b| {
+                let p = w.body_position(b);
+                let angle = w.body_rotation(b).angle();
+                (Vec2::new(f64::from(p.x), f64::from(p.y)), f64::from(angle))
+            }),
+        );
+    }
+    judge.outcome()
+}
