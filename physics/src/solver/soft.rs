@@ -190,6 +190,12 @@ struct PointConstraint {
     max_normal_impulse: f64,
     /// How fast gravity and forces close the gap (along −normal), for the impact speed.
     closing_acceleration: f64,
+    /// The fastest impact `approach` may record: the approach at the step's start plus
+    /// what the closing acceleration adds over the step. Any faster is speed the step's
+    /// other contacts gave the bodies, which a bounce must not return: a small body
+    /// wedged between a wall and another body gained half its speed again each step,
+    /// bounced off the one and the other in turn.
+    fastest_impact: f64,
     /// With the next point: their 2 × 2 normal mass matrix, when the two are one
     /// manifold's and the block is well conditioned (solved together).
     pair_coupling: Option<NormalBlock>,
@@ -453,7 +459,7 @@ impl SoftStepSolver {
             h,
         );
         let started = stage_clock::mark();
-        self.prepare(bodies, accelerations, contacts, joints);
+        self.prepare(bodies, accelerations, contacts, joints, dt);
         stage_clock::record(Stage::Preparing, started);
         for _ in 0..settings.substeps {
             let order = if settings.alternating_sweeps {
@@ -493,6 +499,7 @@ impl SoftStepSolver {
         accelerations: &[(Vec2, f64)],
         contacts: &[Contact],
         joints: &[JointConstraint],
+        dt: f64,
     ) {
         self.bodies.clear();
         self.bodies.extend(bodies.iter().map(|b| SoftBody {
@@ -521,7 +528,7 @@ impl SoftStepSolver {
         // then its points are not written: on a big pile at rest, writing them was a
         // tenth of the step (docs/bench/profile.md, "Points not written").
         self.plan.begin_filling();
-        let skipped = self.build_points(bodies, accelerations, contacts, grouped);
+        let skipped = self.build_points(bodies, accelerations, contacts, grouped, dt);
         self.contact_lcp
             .prepare(&self.bodies, &self.points, &self.contact_islands);
         let kept = self
@@ -539,7 +546,7 @@ impl SoftStepSolver {
             // were written already, and the plan's entries come out the same, so the LCP
             // and the plan's reading stand.
             self.plan.stop_filling();
-            self.build_points(bodies, accelerations, contacts, grouped);
+            self.build_points(bodies, accelerations, contacts, grouped, dt);
         }
         self.contact_grouping = grouping;
         self.plan.plan(&self.points, &self.bodies);
@@ -618,6 +625,7 @@ impl SoftStepSolver {
         accelerations: &[(Vec2, f64)],
         contacts: &[Contact],
         grouped: &[(u32, u32)],
+        dt: f64,
     ) -> bool {
         if self.points.len() < contacts.len() {
             self.points
@@ -674,6 +682,13 @@ impl SoftStepSolver {
             };
             let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
             self.may_bounce |= c.restitution != 0.0;
+            // Read only for points that may bounce (`approach`).
+            let closing_acceleration = if c.restitution == 0.0 {
+                0.0
+            } else {
+                -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
+                    .dot(&c.normal)
+            };
             pending[next] = PointConstraint {
                 contact: i as u32,
                 a: c.body_a,
@@ -689,13 +704,8 @@ impl SoftStepSolver {
                 normal_impulse,
                 tangent_impulse,
                 max_normal_impulse: 0.0,
-                // Read only for points that may bounce (`approach`).
-                closing_acceleration: if c.restitution == 0.0 {
-                    0.0
-                } else {
-                    -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
-                        .dot(&c.normal)
-                },
+                closing_acceleration,
+                fastest_impact: c.approach_velocity - closing_acceleration.max(0.0) * dt,
                 pair_coupling: None,
             };
             let point = &pending[next];
@@ -1036,7 +1046,7 @@ fn approach(pair: &BodyPair, p: &mut PointConstraint, separation: f64) -> f64 {
     if p.restitution != 0.0 && p.max_normal_impulse == 0.0 && vn < 0.0 {
         let gained = 2.0 * p.closing_acceleration * separation.max(0.0);
         let impact = -(vn * vn + gained.max(0.0)).sqrt();
-        p.relative_velocity = p.relative_velocity.min(impact);
+        p.relative_velocity = p.relative_velocity.min(impact.max(p.fastest_impact));
     }
     vn
 }

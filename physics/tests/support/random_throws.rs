@@ -44,6 +44,8 @@ pub const WALLS: [((f64, f64), (f64, f64)); 3] = [
     ((1.0, 22.0), (10.5, -10.0)),
 ];
 pub const WALL_RESTITUTION: f64 = 1.0;
+/// The box's inside height, for the energy's scale.
+const BOX_HEIGHT: f64 = 20.0;
 
 /// SplitMix64: enough randomness for reproducible worlds without a dependency.
 pub struct Numbers(pub u64);
@@ -172,6 +174,9 @@ pub struct Outcome {
     pub step: usize,
     pub class: Class,
     pub masses: (f64, f64),
+    /// pe's runs: the most the total energy rose above its start at the end of any step,
+    /// over Σ m g × the box's height (the property test's measure).
+    pub energy_rise: Option<f64>,
 }
 
 impl Outcome {
@@ -222,6 +227,7 @@ impl Judge {
                 step: 0,
                 class: Class::Gradually,
                 masses: (0.0, 0.0),
+                energy_rise: None,
             },
         }
     }
@@ -289,8 +295,8 @@ pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usiz
     run_in_pe(&Throw::random(numbers), solver, substeps, &mut stepping)
 }
 
-/// Steps `throw` in pe `STEPS` times, and judges it; adds the time spent stepping (not
-/// judging) to `stepping`.
+/// Steps `throw` in pe `STEPS` times, and judges it and its energy; adds the time spent
+/// stepping (not judging) to `stepping`.
 pub fn run_in_pe(
     throw: &Throw,
     solver: ContactSolver,
@@ -302,6 +308,13 @@ pub fn run_in_pe(
     let thrown: Vec<BodyHandle> = (0..throw.bodies.len())
         .map(|k| BodyHandle((WALLS.len() + k) as u32))
         .collect();
+    let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
+    let (start, weight) = (
+        energy(&w),
+        throw.bodies.iter().map(ThrownBody::mass).sum::<f64>(),
+    );
+    let scale = weight * GRAVITY * BOX_HEIGHT;
+    let mut energy_rise: f64 = 0.0;
     for step in 0..STEPS {
         let started = Instant::now();
         w.step(H);
@@ -311,6 +324,10 @@ pub fn run_in_pe(
             (b.origin(), b.angle)
         };
         judge.after_step(step, thrown.iter().map(pose));
+        energy_rise = energy_rise.max((energy(&w) - start) / scale);
     }
-    judge.outcome()
+    Outcome {
+        energy_rise: Some(energy_rise),
+        ..judge.outcome()
+    }
 }

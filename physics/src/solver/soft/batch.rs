@@ -616,6 +616,7 @@ struct LaneBounce<L = F64x8> {
     relative_velocity: L,
     max_normal_impulse: L,
     closing_acceleration: L,
+    fastest_impact: L,
 }
 
 /// Eight manifolds of `N` points (one or two) with no moving body in common, their data
@@ -988,6 +989,7 @@ impl<const N: usize> ManifoldBatch<N> {
                 lane.relative_velocity.0[k] = p.relative_velocity;
                 lane.max_normal_impulse.0[k] = p.max_normal_impulse;
                 lane.closing_acceleration.0[k] = p.closing_acceleration;
+                lane.fastest_impact.0[k] = p.fastest_impact;
             }
         }
         self.bouncing_lanes = if bounces {
@@ -1283,6 +1285,7 @@ fn unused_lane(null_body: u32) -> [PointConstraint; 2] {
         tangent_impulse: 0.0,
         max_normal_impulse: 0.0,
         closing_acceleration: 0.0,
+        fastest_impact: 0.0,
         pair_coupling: Some(NormalBlock {
             k11: 0.0,
             k12: 0.0,
@@ -1355,7 +1358,7 @@ fn approach<L: Lanes>(b: &mut LaneBounce<L>, vn: L, separation: L) {
     let may_bounce = b.restitution.ne(zero) & b.max_normal_impulse.eq(zero) & vn.lt(zero);
     if may_bounce.any() {
         let gained = L::splat(2.0) * b.closing_acceleration * separation.max(zero);
-        let impact = -(vn * vn + gained.max(zero)).sqrt();
+        let impact = (-(vn * vn + gained.max(zero)).sqrt()).max(b.fastest_impact);
         b.relative_velocity =
             may_bounce.select(b.relative_velocity.min(impact), b.relative_velocity);
     }
@@ -1432,6 +1435,8 @@ mod tests {
             tangent_impulse: n.next(-0.1, 0.1),
             max_normal_impulse: if bounces { 0.0 } else { 0.1 },
             closing_acceleration: n.next(0.0, 10.0),
+            // Binds in the lanes whose impact is faster, not in the others.
+            fastest_impact: -1.0,
             pair_coupling: None,
         }
     }
