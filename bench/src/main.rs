@@ -714,7 +714,9 @@ fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
          fifth of its smallest body's radius, by pe's separating-axis test on each \
          engine's poses after every step; it is counted as overlapping from the start (the \
          pair already did in the first 3 steps), in one step (an impact: within the bound \
-         the step before) or gradually. pe's length scale is the median radius (as the app \
+         the step before) or gradually. A throw gains energy when its bodies' kinetic and \
+         potential energy (each body's mass and inertia from its shape) rises after any \
+         step by more than 1% of Σ m g × the box's height above its start. pe's length scale is the median radius (as the app \
          sets a scene's); the peers run at their defaults (1 m). The time is the stepping alone, all throws together.\n",
         first.throws
     );
@@ -722,6 +724,7 @@ fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
         "throws that sink",
         "from the start / in one step / gradually",
         "deepest overlap (smallest radii)",
+        "throws that gain energy (most gained)",
         "time stepping",
     ]
     .map(String::from);
@@ -730,12 +733,14 @@ fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
         let [start, impact, gradual] = r.sunk;
         let _ = writeln!(
             w,
-            "| {} | {} of {} ({:.1}%) | {start} / {impact} / {gradual} | {:.2} | {:.1} s |",
+            "| {} | {} of {} ({:.1}%) | {start} / {impact} / {gradual} | {:.2} | {} ({:.3}) | {:.1} s |",
             r.engine,
             r.sunk_total(),
             r.throws,
             100.0 * r.sunk_total() as f64 / r.throws as f64,
             r.deepest,
+            r.gained,
+            r.most_gained,
             r.stepping.as_secs_f64()
         );
     }

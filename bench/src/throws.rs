@@ -9,8 +9,8 @@ mod random_throws;
 use crate::{box2d_scenes, rapier_scenes};
 use pe::{ContactSolver, Vec2};
 use random_throws::{
-    Class, DENSITY, FRICTION, GRAVITY, H, Judge, Numbers, Outcome, STEPS, Throw, WALL_RESTITUTION,
-    WALLS, run_in_pe,
+    Class, DENSITY, EnergyMeter, FRICTION, GRAVITY, H, Judge, Numbers, Outcome, STEPS, Throw,
+    WALL_RESTITUTION, WALLS, run_in_pe,
 };
 use std::time::{Duration, Instant};
 
@@ -29,6 +29,10 @@ pub struct ThrowsRow {
     pub sunk: [usize; 3],
     /// The deepest overlap of all, over the smallest radius.
     pub deepest: f64,
+    /// The throws whose energy rose by more than 1% of Σ m g × the box's height (the
+    /// property test's bound), and the most any rose.
+    pub gained: usize,
+    pub most_gained: f64,
     /// The time spent stepping (not judging), all throws together.
     pub stepping: Duration,
 }
@@ -69,6 +73,8 @@ pub fn run(throws: usize, seed: u64, list: bool) -> Vec<ThrowsRow> {
                 throws,
                 sunk: [0; 3],
                 deepest: 0.0,
+                gained: 0,
+                most_gained: 0.0,
                 stepping: Duration::ZERO,
             };
             for k in 0..throws {
@@ -81,6 +87,8 @@ pub fn run(throws: usize, seed: u64, list: bool) -> Vec<ThrowsRow> {
                     );
                 }
                 row.deepest = row.deepest.max(outcome.depth);
+                row.most_gained = row.most_gained.max(outcome.energy_rise);
+                row.gained += usize::from(outcome.energy_rise > 0.01);
                 if outcome.sank() {
                     row.sunk[match outcome.class {
                         Class::OverlappingFromStart => 0,
@@ -133,25 +141,32 @@ fn run_in_rapier(throw: &Throw, stepping: &mut Duration) -> Outcome {
         })
         .collect();
     let mut judge = Judge::new(throw);
+    let mut energy = EnergyMeter::new(throw);
+    let widen = |v: Vector| pe::Vec2::new(f64::from(v.x), f64::from(v.y));
     for step in 0..STEPS {
         let started = Instant::now();
         w.step();
         *stepping += started.elapsed();
-        judge.after_step(
-            step,
-            bodies.iter().map(|&h| {
-                let b = &w.bodies[h];
-                let t = b.translation();
-                let at = pe::Vec2::new(f64::from(t.x), f64::from(t.y));
-                (at, f64::from(b.rotation().angle()))
-            }),
-        );
+        let body = |&h: &RigidBodyHandle| &w.bodies[h];
+        let pose = |b: &RigidBody| (widen(b.translation()), f64::from(b.rotation().angle()));
+        judge.after_step(step, bodies.iter().map(body).map(pose));
+        let motion = |b: &RigidBody| {
+            (
+                widen(b.translation()),
+                widen(b.linvel()),
+                f64::from(b.angvel()),
+            )
+        };
+        energy.after_step(bodies.iter().map(body).map(motion));
     }
-    judge.outcome()
+    Outcome {
+        energy_rise: energy.rise(),
+        ..judge.outcome()
+    }
 }
 
 fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
-    use boxdd::{BodyBuilder, BodyType, ShapeDef, SurfaceMaterial, World, WorldDef};
+    use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, World, WorldDef};
     let v = |p: Vec2| boxdd::Vec2::new(p.x as f32, p.y as f32);
     let def = WorldDef::builder()
         .gravity([0.0, GRAVITY as f32])
@@ -199,18 +214,27 @@ fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
         })
         .collect();
     let mut judge = Judge::new(throw);
+    let mut energy = EnergyMeter::new(throw);
+    let widen = |v: boxdd::Vec2| Vec2::new(f64::from(v.x), f64::from(v.y));
     for step in 0..STEPS {
         let started = Instant::now();
         w.step(H as f32, box2d_scenes::SUBSTEPS);
         *stepping += started.elapsed();
-        judge.after_step(
-            step,
-            bodies.iter().map(|&b| {
-                let p = w.body_position(b);
-                let angle = w.body_rotation(b).angle();
-                (Vec2::new(f64::from(p.x), f64::from(p.y)), f64::from(angle))
-            }),
-        );
+        let pose = |&b: &BodyId| {
+            (
+                widen(w.body_position(b)),
+                f64::from(w.body_rotation(b).angle()),
+            )
+        };
+        judge.after_step(step, bodies.iter().map(pose));
+        let motion = |&b: &BodyId| {
+            let (v, spin) = (w.body_linear_velocity(b), w.body_angular_velocity(b));
+            (widen(w.body_position(b)), widen(v), f64::from(spin))
+        };
+        energy.after_step(bodies.iter().map(motion));
     }
-    judge.outcome()
+    Outcome {
+        energy_rise: energy.rise(),
+        ..judge.outcome()
+    }
 }

@@ -1,6 +1,7 @@
 //! How often each contact solver lets bodies sink into each other in random throws
 //! (`physics/tests/support/random_throws.rs` says what a throw is and how it is judged):
-//! the throws past the bound, each with its class, and the count by class.
+//! the throws past the bound, each with its class, the count by class, and the throws
+//! whose energy rose.
 //!
 //! `cargo run --release -p pe --example throw_survey -- [solver] [worlds] [seed] [substeps]`
 //! (defaults: soft, 100, 1, and the soft step's default substeps; solvers by
@@ -28,6 +29,7 @@ fn main() {
     let mut numbers = Numbers(seed);
     let mut stepping = Duration::ZERO;
     let mut failed = Vec::new();
+    let mut gained = 0;
     for world in 0..worlds {
         let outcome = run_in_pe(
             &Throw::random(&mut numbers),
@@ -49,11 +51,19 @@ fn main() {
             );
             failed.push(outcome.class);
         }
+        // The property test's bound on energy.
+        if outcome.energy_rise > 0.01 {
+            println!(
+                "world {world}: {} bodies, energy rose {:.3} of Σ m g × the box's height",
+                outcome.bodies, outcome.energy_rise
+            );
+            gained += 1;
+        }
     }
     let count = |class| failed.iter().filter(|&&c| c == class).count();
     let substeps = substeps.map_or(String::new(), |n| format!(" ({n} substeps)"));
     println!(
-        "{}{substeps}: {} of {worlds} worlds deeper than {BOUND} radii (overlapping from the start {}, in one step {}, gradually {}); {:.1} s stepping",
+        "{}{substeps}: {} of {worlds} worlds deeper than {BOUND} radii (overlapping from the start {}, in one step {}, gradually {}), {gained} gained energy; {:.1} s stepping",
         solver.name(),
         failed.len(),
         count(Class::OverlappingFromStart),

@@ -84,6 +84,11 @@ impl ThrownBody {
     pub fn mass(&self) -> f64 {
         DENSITY * self.shape.mass_properties().area
     }
+
+    /// About its centre, which is its position: a regular polygon's centroid.
+    pub fn inertia(&self) -> f64 {
+        DENSITY * self.shape.mass_properties().second_moment
+    }
 }
 
 /// A random world: 2–23 regular polygons of 3–8 sides, radius 0.2–1.5, random poses,
@@ -174,9 +179,9 @@ pub struct Outcome {
     pub step: usize,
     pub class: Class,
     pub masses: (f64, f64),
-    /// pe's runs: the most the total energy rose above its start at the end of any step,
-    /// over Σ m g × the box's height (the property test's measure).
-    pub energy_rise: Option<f64>,
+    /// The most the total energy rose above its start at the end of any step, over
+    /// Σ m g × the box's height (the property test's measure; `EnergyMeter`).
+    pub energy_rise: f64,
 }
 
 impl Outcome {
@@ -227,7 +232,7 @@ impl Judge {
                 step: 0,
                 class: Class::Gradually,
                 masses: (0.0, 0.0),
-                energy_rise: None,
+                energy_rise: 0.0,
             },
         }
     }
@@ -289,6 +294,56 @@ impl Judge {
     }
 }
 
+/// The thrown bodies' energy, kinetic and in gravity, from their motion after each step,
+/// with each body's mass and inertia from its shape (the same for every engine).
+pub struct EnergyMeter {
+    /// Each body's mass and inertia.
+    bodies: Vec<(f64, f64)>,
+    start: f64,
+    scale: f64,
+    rise: f64,
+}
+
+/// A body's motion: position, velocity and spin.
+pub type Motion = (Vec2, Vec2, f64);
+
+impl EnergyMeter {
+    pub fn new(throw: &Throw) -> Self {
+        let bodies: Vec<(f64, f64)> = (throw.bodies.iter())
+            .map(|b| (b.mass(), b.inertia()))
+            .collect();
+        let weight: f64 = bodies.iter().map(|&(m, _)| m * GRAVITY).sum();
+        let mut meter = Self {
+            bodies,
+            start: 0.0,
+            scale: weight * BOX_HEIGHT,
+            rise: 0.0,
+        };
+        let motions = throw.bodies.iter().map(|b| (b.at, b.velocity, b.spin));
+        meter.start = meter.energy(motions);
+        meter
+    }
+
+    fn energy(&self, motions: impl Iterator<Item = Motion>) -> f64 {
+        // y points down, along gravity: the potential energy is −m g y.
+        let each = self.bodies.iter().zip(motions);
+        each.map(|(&(m, i), (at, v, w))| {
+            0.5 * (m * v.norm_squared() + i * w * w) - m * GRAVITY * at.y
+        })
+        .sum()
+    }
+
+    /// After a step, with each thrown body's motion in order.
+    pub fn after_step(&mut self, motions: impl Iterator<Item = Motion>) {
+        let rise = (self.energy(motions) - self.start) / self.scale;
+        self.rise = self.rise.max(rise);
+    }
+
+    pub fn rise(&self) -> f64 {
+        self.rise
+    }
+}
+
 /// Throws the next random world under pe's `solver` (`run_in_pe`).
 pub fn throw(numbers: &mut Numbers, solver: ContactSolver, substeps: Option<usize>) -> Outcome {
     let mut stepping = Duration::ZERO;
@@ -308,13 +363,7 @@ pub fn run_in_pe(
     let thrown: Vec<BodyHandle> = (0..throw.bodies.len())
         .map(|k| BodyHandle((WALLS.len() + k) as u32))
         .collect();
-    let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
-    let (start, weight) = (
-        energy(&w),
-        throw.bodies.iter().map(ThrownBody::mass).sum::<f64>(),
-    );
-    let scale = weight * GRAVITY * BOX_HEIGHT;
-    let mut energy_rise: f64 = 0.0;
+    let mut energy = EnergyMeter::new(throw);
     for step in 0..STEPS {
         let started = Instant::now();
         w.step(H);
@@ -324,10 +373,14 @@ pub fn run_in_pe(
             (b.origin(), b.angle)
         };
         judge.after_step(step, thrown.iter().map(pose));
-        energy_rise = energy_rise.max((energy(&w) - start) / scale);
+        let motion = |&h: &BodyHandle| {
+            let b = w.body(h).expect("a thrown body");
+            (b.position, b.velocity, b.angular_velocity)
+        };
+        energy.after_step(thrown.iter().map(motion));
     }
     Outcome {
-        energy_rise: Some(energy_rise),
+        energy_rise: energy.rise(),
         ..judge.outcome()
     }
 }
