@@ -1036,7 +1036,7 @@ fn warm_start_point(bodies: &mut [SoftBody], p: &PointConstraint) {
 ///
 /// Until the point first pushes, this also records the fastest approach: the bounce at the
 /// end of the step reverses the speed of the impact, which gravity may have raised since
-/// the step began.
+/// the step began (and nothing else has: no faster than `fastest_impact`).
 /// A speculative point closes its remaining gap within the substep without speeding up
 /// over it; the impact speed adds what the closing acceleration would have given there.
 /// Only a point that may bounce needs it.
