@@ -699,7 +699,7 @@ proptest! {
 /// 400 throws under `soft` (5 sink) and 100 under `thesis` (none), allowed 14 and 7:
 /// three binomial deviations above their long-run rates, so that what fails is a solver
 /// that sinks more often, not the draw. Energy: at most 1% of Σ m g × the box's height
-/// above its start, as in the property above; 9 of these 400 `soft` throws rose by 7–125%
+/// above its start, as in the property above; 9 of these 400 `soft` throws rose by 6–125%
 /// when a bounce could return speed that other contacts gave in the same step (a small
 /// body wedged between a wall and a heavy one), and with it 13 sank. (With the length
 /// scale at the smallest radius instead of the median, both solvers sank one throw in
