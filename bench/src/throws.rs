@@ -1,7 +1,7 @@
 //! Random throws in every engine: the same worlds (`Throw`, from pe's hard-case tests) in
 //! pe, rapier2d and Box2D v3, each judged from its bodies' poses after every step by the
-//! same separating-axis test (`Judge`): how often a throw sinks past a fifth of the
-//! smallest radius, and how.
+//! same separating-axis test (`Judge`) and energy meter (`EnergyMeter`): how often a throw
+//! sinks past a fifth of the smallest radius, and how, and whether it gains energy.
 
 #[path = "../../physics/tests/support/random_throws.rs"]
 mod random_throws;
@@ -29,8 +29,7 @@ pub struct ThrowsRow {
     pub sunk: [usize; 3],
     /// The deepest overlap of all, over the smallest radius.
     pub deepest: f64,
-    /// The throws whose energy rose by more than 1% of Σ m g × the box's height (the
-    /// property test's bound), and the most any rose.
+    /// The throws that gained energy (`Outcome::gained_energy`), and the most any rose.
     pub gained: usize,
     pub most_gained: f64,
     /// The time spent stepping (not judging), all throws together.
@@ -88,7 +87,7 @@ pub fn run(throws: usize, seed: u64, list: bool) -> Vec<ThrowsRow> {
                 }
                 row.deepest = row.deepest.max(outcome.depth);
                 row.most_gained = row.most_gained.max(outcome.energy_rise);
-                row.gained += usize::from(outcome.energy_rise > 0.01);
+                row.gained += usize::from(outcome.gained_energy());
                 if outcome.sank() {
                     row.sunk[match outcome.class {
                         Class::OverlappingFromStart => 0,

@@ -29,6 +29,9 @@ pub const STEPS: usize = 1000;
 /// Deepest overlaps are judged from this step on (2 s), as in the property test.
 const JUDGED_FROM: usize = 120;
 pub const BOUND: f64 = 0.2;
+/// A throw gains energy if it rises above its start by more than this much of
+/// Σ m g × the box's height (the property test's bound).
+pub const ENERGY_BOUND: f64 = 0.01;
 /// Along +y: pe's y points down.
 pub const GRAVITY: f64 = 10.0;
 /// Every contact's friction coefficient.
@@ -187,6 +190,10 @@ pub struct Outcome {
 impl Outcome {
     pub fn sank(&self) -> bool {
         self.depth > BOUND
+    }
+
+    pub fn gained_energy(&self) -> bool {
+        self.energy_rise > ENERGY_BOUND
     }
 }
 
