@@ -129,9 +129,11 @@ fn main() {
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("throws") {
-        let arg = |k: usize| std::env::args().nth(k).and_then(|a| a.parse().ok());
-        let count = arg(2).map_or(throws::THROWS, |c: u64| c as usize);
-        let seed = arg(3).unwrap_or(throws::SEED);
+        let arg = |k: usize| std::env::args().nth(k);
+        let count = arg(2)
+            .and_then(|a| a.parse().ok())
+            .unwrap_or(throws::THROWS);
+        let seed = arg(3).and_then(|a| a.parse().ok()).unwrap_or(throws::SEED);
         let list = std::env::args().any(|a| a == "list");
         let mut md = String::new();
         write_throws(&mut md, &throws::run(count, seed, list), seed);
@@ -697,7 +699,8 @@ fn report(
     md
 }
 
-/// The random throws' section: each engine's throws that sank, by class.
+/// The random throws' section: each engine's throws that sank, by class, and that gained
+/// energy.
 fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
     let Some(first) = rows.first() else {
         return;
@@ -716,8 +719,9 @@ fn write_throws(w: &mut String, rows: &[throws::ThrowsRow], seed: u64) {
          pair already did in the first 3 steps), in one step (an impact: within the bound \
          the step before) or gradually. A throw gains energy when its bodies' kinetic and \
          potential energy (each body's mass and inertia from its shape) rises after any \
-         step by more than 1% of Σ m g × the box's height above its start. pe's length scale is the median radius (as the app \
-         sets a scene's); the peers run at their defaults (1 m). The time is the stepping alone, all throws together.\n",
+         step by more than 1% of Σ m g × the box's height above its start. pe's length \
+         scale is the median radius (as the app sets a scene's); the peers run at their \
+         defaults (1 m). The time is the stepping alone, all throws together.\n",
         first.throws
     );
     let columns = [

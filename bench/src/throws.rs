@@ -1,6 +1,6 @@
 //! Random throws in every engine: the same worlds (`Throw`, from pe's hard-case tests) in
 //! pe, rapier2d and Box2D v3, each judged from its bodies' poses after every step by the
-//! same separating-axis test (`Judge`) and energy meter (`EnergyMeter`): how often a throw
+//! same separating-axis test and energy meter (`Judge`): how often a throw
 //! sinks past a fifth of the smallest radius, and how, and whether it gains energy.
 
 #[path = "../../physics/tests/support/random_throws.rs"]
@@ -9,7 +9,7 @@ mod random_throws;
 use crate::{box2d_scenes, rapier_scenes};
 use pe::{ContactSolver, Vec2};
 use random_throws::{
-    Class, DENSITY, EnergyMeter, FRICTION, GRAVITY, H, Judge, Numbers, Outcome, STEPS, Throw,
+    BodyState, Class, DENSITY, FRICTION, GRAVITY, H, Judge, Numbers, Outcome, STEPS, Throw,
     WALL_RESTITUTION, WALLS, run_in_pe,
 };
 use std::time::{Duration, Instant};
@@ -140,28 +140,23 @@ fn run_in_rapier(throw: &Throw, stepping: &mut Duration) -> Outcome {
         })
         .collect();
     let mut judge = Judge::new(throw);
-    let mut energy = EnergyMeter::new(throw);
     let widen = |v: Vector| pe::Vec2::new(f64::from(v.x), f64::from(v.y));
     for step in 0..STEPS {
         let started = Instant::now();
         w.step();
         *stepping += started.elapsed();
-        let body = |&h: &RigidBodyHandle| &w.bodies[h];
-        let pose = |b: &RigidBody| (widen(b.translation()), f64::from(b.rotation().angle()));
-        judge.after_step(step, bodies.iter().map(body).map(pose));
-        let motion = |b: &RigidBody| {
-            (
-                widen(b.translation()),
-                widen(b.linvel()),
-                f64::from(b.angvel()),
-            )
+        let state = |&h: &RigidBodyHandle| {
+            let b = &w.bodies[h];
+            BodyState {
+                at: widen(b.translation()),
+                angle: f64::from(b.rotation().angle()),
+                velocity: widen(b.linvel()),
+                spin: f64::from(b.angvel()),
+            }
         };
-        energy.after_step(bodies.iter().map(body).map(motion));
+        judge.after_step(step, bodies.iter().map(state));
     }
-    Outcome {
-        energy_rise: energy.rise(),
-        ..judge.outcome()
-    }
+    judge.outcome()
 }
 
 fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
@@ -213,27 +208,18 @@ fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
         })
         .collect();
     let mut judge = Judge::new(throw);
-    let mut energy = EnergyMeter::new(throw);
     let widen = |v: boxdd::Vec2| Vec2::new(f64::from(v.x), f64::from(v.y));
     for step in 0..STEPS {
         let started = Instant::now();
         w.step(H as f32, box2d_scenes::SUBSTEPS);
         *stepping += started.elapsed();
-        let pose = |&b: &BodyId| {
-            (
-                widen(w.body_position(b)),
-                f64::from(w.body_rotation(b).angle()),
-            )
+        let state = |&b: &BodyId| BodyState {
+            at: widen(w.body_position(b)),
+            angle: f64::from(w.body_rotation(b).angle()),
+            velocity: widen(w.body_linear_velocity(b)),
+            spin: f64::from(w.body_angular_velocity(b)),
         };
-        judge.after_step(step, bodies.iter().map(pose));
-        let motion = |&b: &BodyId| {
-            let (v, spin) = (w.body_linear_velocity(b), w.body_angular_velocity(b));
-            (widen(w.body_position(b)), widen(v), f64::from(spin))
-        };
-        energy.after_step(bodies.iter().map(motion));
+        judge.after_step(step, bodies.iter().map(state));
     }
-    Outcome {
-        energy_rise: energy.rise(),
-        ..judge.outcome()
-    }
+    judge.outcome()
 }

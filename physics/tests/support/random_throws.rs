@@ -197,8 +197,19 @@ impl Outcome {
     }
 }
 
-/// Judges a throw from its bodies' poses after each step: every pair's deepest overlap by
-/// pe's separating-axis test and clipping (the depth pe's contacts report).
+/// A thrown body after a step, as any engine reports it: its position (its vertex
+/// origin, which is its centre: a regular polygon's centroid), angle, velocity and spin.
+#[derive(Debug, Clone, Copy)]
+pub struct BodyState {
+    pub at: Vec2,
+    pub angle: f64,
+    pub velocity: Vec2,
+    pub spin: f64,
+}
+
+/// Judges a throw from its bodies' states after each step: every pair's deepest overlap by
+/// pe's separating-axis test and clipping (the depth pe's contacts report), and the
+/// energy (`EnergyMeter`).
 pub struct Judge {
     smallest: f64,
     /// The walls' polygons, then the thrown bodies' at their last poses.
@@ -210,6 +221,9 @@ pub struct Judge {
     /// before, and at this one in the pairs' order (so that ties go the same way each run).
     before: HashMap<(usize, usize), f64>,
     now: Vec<((usize, usize), f64)>,
+    energy: EnergyMeter,
+    /// This step's states, read twice.
+    states: Vec<BodyState>,
     outcome: Outcome,
 }
 
@@ -233,6 +247,8 @@ impl Judge {
             overlapping_at_start: HashSet::new(),
             before: HashMap::new(),
             now: Vec::new(),
+            energy: EnergyMeter::new(throw),
+            states: Vec::new(),
             outcome: Outcome {
                 bodies: throw.bodies.len(),
                 depth: 0.0,
@@ -244,13 +260,16 @@ impl Judge {
         }
     }
 
-    /// After step `step` (from 0), with each thrown body's pose (position, angle) in order.
-    pub fn after_step(&mut self, step: usize, poses: impl Iterator<Item = (Vec2, f64)>) {
+    /// After step `step` (from 0), with each thrown body's state in order.
+    pub fn after_step(&mut self, step: usize, states: impl Iterator<Item = BodyState>) {
+        self.states.clear();
+        self.states.extend(states);
+        self.energy.after_step(&self.states);
         self.polygons.truncate(WALLS.len());
-        for ((vertices, _), (at, angle)) in self.shapes.iter().zip(poses) {
-            let turn = Rot::new(angle);
+        for ((vertices, _), state) in self.shapes.iter().zip(&self.states) {
+            let turn = Rot::new(state.angle);
             let mut polygon = WorldPolygon::default();
-            polygon.set_vertices(vertices.iter().map(|&v| at + turn.apply(v)));
+            polygon.set_vertices(vertices.iter().map(|&v| state.at + turn.apply(v)));
             self.polygons.push(polygon);
         }
         self.before.clear();
@@ -297,13 +316,16 @@ impl Judge {
     }
 
     pub fn outcome(self) -> Outcome {
-        self.outcome
+        Outcome {
+            energy_rise: self.energy.rise(),
+            ..self.outcome
+        }
     }
 }
 
-/// The thrown bodies' energy, kinetic and in gravity, from their motion after each step,
+/// The thrown bodies' energy, kinetic and in gravity, from their states after each step,
 /// with each body's mass and inertia from its shape (the same for every engine).
-pub struct EnergyMeter {
+struct EnergyMeter {
     /// Each body's mass and inertia.
     bodies: Vec<(f64, f64)>,
     start: f64,
@@ -311,11 +333,8 @@ pub struct EnergyMeter {
     rise: f64,
 }
 
-/// A body's motion: position, velocity and spin.
-pub type Motion = (Vec2, Vec2, f64);
-
 impl EnergyMeter {
-    pub fn new(throw: &Throw) -> Self {
+    fn new(throw: &Throw) -> Self {
         let bodies: Vec<(f64, f64)> = (throw.bodies.iter())
             .map(|b| (b.mass(), b.inertia()))
             .collect();
@@ -326,12 +345,13 @@ impl EnergyMeter {
             scale: weight * BOX_HEIGHT,
             rise: 0.0,
         };
-        let motions = throw.bodies.iter().map(|b| (b.at, b.velocity, b.spin));
-        meter.start = meter.energy(motions);
+        let starts = throw.bodies.iter().map(|b| (b.at, b.velocity, b.spin));
+        meter.start = meter.energy(starts);
         meter
     }
 
-    fn energy(&self, motions: impl Iterator<Item = Motion>) -> f64 {
+    /// Of bodies at (position, velocity, spin).
+    fn energy(&self, motions: impl Iterator<Item = (Vec2, Vec2, f64)>) -> f64 {
         // y points down, along gravity: the potential energy is −m g y.
         let each = self.bodies.iter().zip(motions);
         each.map(|(&(m, i), (at, v, w))| {
@@ -340,13 +360,13 @@ impl EnergyMeter {
         .sum()
     }
 
-    /// After a step, with each thrown body's motion in order.
-    pub fn after_step(&mut self, motions: impl Iterator<Item = Motion>) {
+    fn after_step(&mut self, states: &[BodyState]) {
+        let motions = states.iter().map(|s| (s.at, s.velocity, s.spin));
         let rise = (self.energy(motions) - self.start) / self.scale;
         self.rise = self.rise.max(rise);
     }
 
-    pub fn rise(&self) -> f64 {
+    fn rise(&self) -> f64 {
         self.rise
     }
 }
@@ -370,24 +390,20 @@ pub fn run_in_pe(
     let thrown: Vec<BodyHandle> = (0..throw.bodies.len())
         .map(|k| BodyHandle((WALLS.len() + k) as u32))
         .collect();
-    let mut energy = EnergyMeter::new(throw);
     for step in 0..STEPS {
         let started = Instant::now();
         w.step(H);
         *stepping += started.elapsed();
-        let pose = |&h: &BodyHandle| {
+        let state = |&h: &BodyHandle| {
             let b = w.body(h).expect("a thrown body");
-            (b.origin(), b.angle)
+            BodyState {
+                at: b.origin(),
+                angle: b.angle,
+                velocity: b.velocity,
+                spin: b.angular_velocity,
+            }
         };
-        judge.after_step(step, thrown.iter().map(pose));
-        let motion = |&h: &BodyHandle| {
-            let b = w.body(h).expect("a thrown body");
-            (b.position, b.velocity, b.angular_velocity)
-        };
-        energy.after_step(thrown.iter().map(motion));
+        judge.after_step(step, thrown.iter().map(state));
     }
-    Outcome {
-        energy_rise: energy.rise(),
-        ..judge.outcome()
-    }
+    judge.outcome()
 }
