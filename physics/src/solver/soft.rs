@@ -97,7 +97,7 @@ impl Softness {
 
 /// A body during the soft step: velocity, inverse mass, and how far it moved this step.
 ///
-/// Laid out for the batches' SIMD paths (`avx2::F64x8Avx2::gather`, `avx512`), which read
+/// Laid out for the batches' SIMD paths (`avx2::HalfAvx2::gather`, `avx512`), which read
 /// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
 /// transpose them into lanes: the two rows start at 0 and 32 bytes, and a body is
 /// 32-byte aligned.

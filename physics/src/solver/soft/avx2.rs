@@ -1,8 +1,11 @@
-//! The batches' eight lanes as two AVX2 registers (`Lanes` for `F64x8Avx2`), lanes 0–3
-//! and 4–7, for the functions compiled with `#[target_feature(enable = "avx2")]` and
-//! nothing else: the compiler had vectorised plain arrays there, but not their loads
-//! from the bodies, which it split into scalar moves and spilled (a two-point batch of
-//! four lanes took ~720 instructions a pass).
+//! Half of a batch's eight lanes in one AVX2 register (`Lanes` for `HalfAvx2<H>`: lanes
+//! 0–3 for `H = 0`, 4–7 for `H = 1`), for the functions compiled with
+//! `#[target_feature(enable = "avx2")]` and nothing else. Those functions solve a batch
+//! half by half: its manifolds share no moving body, so each half is solved as if alone,
+//! and a half whose lanes are all unused is skipped. All eight lanes at once, in two
+//! registers a row, spilled: the pair's velocities alone are sixteen registers, all that
+//! AVX2 has (a two-point batch's pass 666K against 564K instructions a step on the 20-row
+//! pyramid with four lanes, docs/bench/profile.md).
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
@@ -18,24 +21,31 @@ use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 
-/// Eight f64 lanes in two 256-bit registers, lanes 0–3 then 4–7; the same size, layout
-/// and alignment as `F64x8`.
+/// Lanes `4H..4H + 4` of a batch's eight, read from and written to their half of an
+/// `F64x8` (the same size, layout and alignment). A value computed here carries its lanes
+/// in both halves; only `set` writes into a batch, and only this half, so that solving
+/// one half leaves the other's numbers as they were.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
-pub(super) struct F64x8Avx2(__m256d, __m256d);
+pub(super) struct HalfAvx2<const H: usize>([__m256d; 2]);
 
-/// A lane-wise condition: all ones or all zeros per lane, in the lanes' two halves.
+/// A lane-wise condition of a half: all ones or all zeros per lane.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct MaskAvx2(__m256d, __m256d);
+pub(super) struct HalfMaskAvx2(__m256d);
 
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<F64x8Avx2>() == size_of::<F64x8>());
-    assert!(align_of::<F64x8Avx2>() == align_of::<F64x8>());
+    assert!(size_of::<HalfAvx2<0>>() == size_of::<F64x8>());
+    assert!(align_of::<HalfAvx2<0>>() == align_of::<F64x8>());
+    assert!(size_of::<HalfAvx2<1>>() == size_of::<F64x8>());
+    assert!(align_of::<HalfAvx2<1>>() == align_of::<F64x8>());
 };
 
+/// Lanes a half holds.
+const HALF: usize = LANES / 2;
+
 // SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions this
-// type is used in are compiled for and only called with (`ManifoldBatch::as_avx2`); the
+// type is used in are compiled for and only called with (`ManifoldBatch::as_lanes`); the
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
 // inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`, and
 // the bodies lie inside the slice (`Lanes::gather`'s precondition).
@@ -72,35 +82,54 @@ fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
-/// `f` on each half of `a` and `b`'s lanes.
-#[inline(always)]
-fn halves(a: F64x8Avx2, b: F64x8Avx2, f: impl Fn(__m256d, __m256d) -> __m256d) -> F64x8Avx2 {
-    F64x8Avx2(f(a.0, b.0), f(a.1, b.1))
+impl<const H: usize> HalfAvx2<H> {
+    /// This half's lanes.
+    #[inline(always)]
+    fn lanes(self) -> __m256d {
+        self.0[H]
+    }
+
+    /// A value with `lanes` as this half's (in both halves: see the type).
+    #[inline(always)]
+    fn of(lanes: __m256d) -> Self {
+        Self([lanes; 2])
+    }
+
+    /// `f` on this half's lanes of `a` and `b`.
+    #[inline(always)]
+    fn zip(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> Self {
+        Self::of(f(a.lanes(), b.lanes()))
+    }
+
+    /// The comparison `f` on this half's lanes, as a mask.
+    #[inline(always)]
+    fn compare(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> HalfMaskAvx2 {
+        HalfMaskAvx2(f(a.lanes(), b.lanes()))
+    }
+
+    /// `if lo > self { lo } else { self }`, the lower bound of `clamp`.
+    #[inline(always)]
+    fn max_of(self, lo: Self) -> Self {
+        Self::zip(lo, self, |a, b| unsafe { _mm256_max_pd(a, b) })
+    }
 }
 
-/// The comparison `f` on each half, as a mask.
-#[inline(always)]
-fn compare(a: F64x8Avx2, b: F64x8Avx2, f: impl Fn(__m256d, __m256d) -> __m256d) -> MaskAvx2 {
-    MaskAvx2(f(a.0, b.0), f(a.1, b.1))
-}
-
-impl Lanes for F64x8Avx2 {
-    type Mask = MaskAvx2;
+impl<const H: usize> Lanes for HalfAvx2<H> {
+    type Mask = HalfMaskAvx2;
 
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        let x = unsafe { _mm256_set1_pd(x) };
-        Self(x, x)
+        Self::of(unsafe { _mm256_set1_pd(x) })
     }
 
     #[inline(always)]
     fn max(self, rhs: Self) -> Self {
-        halves(self, rhs, |a, b| unsafe { _mm256_max_pd(a, b) })
+        Self::zip(self, rhs, |a, b| unsafe { _mm256_max_pd(a, b) })
     }
 
     #[inline(always)]
     fn min(self, rhs: Self) -> Self {
-        halves(self, rhs, |a, b| unsafe { _mm256_min_pd(a, b) })
+        Self::zip(self, rhs, |a, b| unsafe { _mm256_min_pd(a, b) })
     }
 
     #[inline(always)]
@@ -110,53 +139,56 @@ impl Lanes for F64x8Avx2 {
 
     #[inline(always)]
     fn sqrt(self) -> Self {
-        Self(unsafe { _mm256_sqrt_pd(self.0) }, unsafe {
-            _mm256_sqrt_pd(self.1)
-        })
+        Self::of(unsafe { _mm256_sqrt_pd(self.lanes()) })
     }
 
     #[inline(always)]
-    fn gt(self, rhs: Self) -> MaskAvx2 {
-        compare(self, rhs, |a, b| unsafe {
+    fn gt(self, rhs: Self) -> HalfMaskAvx2 {
+        Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_GT_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn ge(self, rhs: Self) -> MaskAvx2 {
-        compare(self, rhs, |a, b| unsafe {
+    fn ge(self, rhs: Self) -> HalfMaskAvx2 {
+        Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_GE_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn lt(self, rhs: Self) -> MaskAvx2 {
-        compare(self, rhs, |a, b| unsafe {
+    fn lt(self, rhs: Self) -> HalfMaskAvx2 {
+        Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_LT_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn eq(self, rhs: Self) -> MaskAvx2 {
-        compare(self, rhs, |a, b| unsafe {
+    fn eq(self, rhs: Self) -> HalfMaskAvx2 {
+        Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_EQ_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn ne(self, rhs: Self) -> MaskAvx2 {
-        compare(self, rhs, |a, b| unsafe {
+    fn ne(self, rhs: Self) -> HalfMaskAvx2 {
+        Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_NEQ_UQ>(a, b)
         })
+    }
+
+    /// This half's lanes only: the other half of `self` keeps its numbers.
+    #[inline(always)]
+    fn set(&mut self, value: Self) {
+        self.0[H] = value.lanes();
     }
 
     #[inline(always)]
     unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
         // Written out: `array::map` was left out of line here.
-        let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[k], which)) };
-        let [a0, a1, a2, a3] = transpose([load(0), load(1), load(2), load(3)]);
-        let [b0, b1, b2, b3] = transpose([load(4), load(5), load(6), load(7)]);
-        [Self(a0, b0), Self(a1, b1), Self(a2, b2), Self(a3, b3)]
+        let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[H * HALF + k], which)) };
+        let [c0, c1, c2, c3] = transpose([load(0), load(1), load(2), load(3)]);
+        [Self::of(c0), Self::of(c1), Self::of(c2), Self::of(c3)]
     }
 
     #[inline(always)]
@@ -165,73 +197,56 @@ impl Lanes for F64x8Avx2 {
         bodies: &mut [SoftBody],
         index: &[u32; LANES],
     ) {
-        let [c0, c1, c2, c3] = columns;
-        let low = transpose([c0.0, c1.0, c2.0, c3.0]);
-        let high = transpose([c0.1, c1.1, c2.1, c3.1]);
-        for (k, row) in low.into_iter().chain(high).enumerate() {
-            let at = row_mut(bodies, index[k], BodyRow::Velocity);
+        let [c0, c1, c2, c3] = columns.map(Self::lanes);
+        for (k, row) in transpose([c0, c1, c2, c3]).into_iter().enumerate() {
+            let at = row_mut(bodies, index[H * HALF + k], BodyRow::Velocity);
             unsafe { _mm256_store_pd(at, row) };
         }
     }
 }
 
-impl F64x8Avx2 {
-    /// `if lo > self { lo } else { self }`, the lower bound of `clamp`.
-    #[inline(always)]
-    fn max_of(self, lo: Self) -> Self {
-        halves(lo, self, |a, b| unsafe { _mm256_max_pd(a, b) })
-    }
-}
-
-impl LaneMask<F64x8Avx2> for MaskAvx2 {
+impl<const H: usize> LaneMask<HalfAvx2<H>> for HalfMaskAvx2 {
     #[inline(always)]
     fn any(self) -> bool {
-        unsafe { _mm256_movemask_pd(_mm256_or_pd(self.0, self.1)) != 0 }
+        unsafe { _mm256_movemask_pd(self.0) != 0 }
     }
 
     #[inline(always)]
-    fn select(self, if_true: F64x8Avx2, if_false: F64x8Avx2) -> F64x8Avx2 {
-        F64x8Avx2(
-            unsafe { _mm256_blendv_pd(if_false.0, if_true.0, self.0) },
-            unsafe { _mm256_blendv_pd(if_false.1, if_true.1, self.1) },
-        )
+    fn select(self, if_true: HalfAvx2<H>, if_false: HalfAvx2<H>) -> HalfAvx2<H> {
+        HalfAvx2::of(unsafe { _mm256_blendv_pd(if_false.lanes(), if_true.lanes(), self.0) })
     }
 }
 
-impl BitAnd for MaskAvx2 {
+impl BitAnd for HalfMaskAvx2 {
     type Output = Self;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_and_pd(self.0, rhs.0) }, unsafe {
-            _mm256_and_pd(self.1, rhs.1)
-        })
+        Self(unsafe { _mm256_and_pd(self.0, rhs.0) })
     }
 }
 
-impl BitXor for MaskAvx2 {
+impl BitXor for HalfMaskAvx2 {
     type Output = Self;
     #[inline(always)]
     fn bitxor(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_xor_pd(self.0, rhs.0) }, unsafe {
-            _mm256_xor_pd(self.1, rhs.1)
-        })
+        Self(unsafe { _mm256_xor_pd(self.0, rhs.0) })
     }
 }
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $intrinsic:ident) => {
-        impl $trait for F64x8Avx2 {
+        impl<const H: usize> $trait for HalfAvx2<H> {
             type Output = Self;
             #[inline(always)]
             fn $method(self, rhs: Self) -> Self {
-                halves(self, rhs, |a, b| unsafe { $intrinsic(a, b) })
+                Self::zip(self, rhs, |a, b| unsafe { $intrinsic(a, b) })
             }
         }
 
-        impl $assign_trait for F64x8Avx2 {
+        impl<const H: usize> $assign_trait for HalfAvx2<H> {
             #[inline(always)]
             fn $assign(&mut self, rhs: Self) {
-                *self = halves(*self, rhs, |a, b| unsafe { $intrinsic(a, b) });
+                *self = Self::zip(*self, rhs, |a, b| unsafe { $intrinsic(a, b) });
             }
         }
     };
@@ -240,22 +255,20 @@ macro_rules! lane_op {
 lane_op!(Add, add, AddAssign, add_assign, _mm256_add_pd);
 lane_op!(Sub, sub, SubAssign, sub_assign, _mm256_sub_pd);
 
-impl Mul for F64x8Avx2 {
+impl<const H: usize> Mul for HalfAvx2<H> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
-        halves(self, rhs, |a, b| unsafe { _mm256_mul_pd(a, b) })
+        Self::zip(self, rhs, |a, b| unsafe { _mm256_mul_pd(a, b) })
     }
 }
 
-impl Neg for F64x8Avx2 {
+impl<const H: usize> Neg for HalfAvx2<H> {
     type Output = Self;
     /// The sign bit flipped, as `-x` does.
     #[inline(always)]
     fn neg(self) -> Self {
         let sign = unsafe { _mm256_set1_pd(-0.0) };
-        Self(unsafe { _mm256_xor_pd(self.0, sign) }, unsafe {
-            _mm256_xor_pd(self.1, sign)
-        })
+        Self::of(unsafe { _mm256_xor_pd(self.lanes(), sign) })
     }
 }

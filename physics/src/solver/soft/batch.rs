@@ -18,7 +18,7 @@
 //! 0.25% of a box over 500 steps (Box2D v3 0.94%): see docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
-use super::avx2::F64x8Avx2;
+use super::avx2::HalfAvx2;
 #[cfg(target_arch = "x86_64")]
 use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
@@ -622,7 +622,7 @@ struct LaneBounce<L = F64x8> {
 /// Eight manifolds of `N` points (one or two) with no moving body in common, their data
 /// lane by lane; each manifold's points stay in `points` too, which this batch updates at
 /// the end of the substeps. Stored with `F64x8` lanes; `repr(C)`, so that the AVX2 and
-/// AVX-512 paths read the same bytes as `ManifoldBatch<N, F64x8Avx2>` and
+/// AVX-512 paths read the same bytes as `ManifoldBatch<N, HalfAvx2<H>>` and
 /// `ManifoldBatch<N, F64x8Avx512>`.
 #[derive(Debug, Clone, Copy)]
 #[repr(C)]
@@ -660,10 +660,10 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
 #[cfg(target_arch = "x86_64")]
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx2>>());
-    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx2>>());
-    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx2>>());
-    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, F64x8Avx2>>());
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, HalfAvx2<1>>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, HalfAvx2<1>>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, HalfAvx2<1>>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, HalfAvx2<1>>>());
     assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx512>>());
     assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx512>>());
     assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx512>>());
@@ -785,7 +785,7 @@ pub(super) struct PassSettings {
 pub(super) enum LanePath {
     /// `F64x8`: plain arrays, any processor.
     Portable,
-    /// `F64x8Avx2`: two 256-bit registers.
+    /// `HalfAvx2`: a 256-bit register, a batch solved half by half.
     #[cfg(target_arch = "x86_64")]
     Avx2,
     /// `F64x8Avx512`: one 512-bit register.
@@ -801,12 +801,14 @@ pub(super) const PAD: u32 = u32::MAX;
 impl LanePath {
     /// The fewest manifolds worth a batch of their own at the end of a colour, the other
     /// lanes unused: a batch's pass costs about three manifolds' alone in AVX-512 (one
-    /// register a lane row), six in AVX2 (two).
+    /// register a lane row) and in AVX2 (whose pass skips an unused upper half; two or
+    /// three made the same instructions on the 20-row pyramid and the smash), six in the
+    /// portable lanes.
     pub(super) fn fewest_padded(self) -> usize {
         match self {
             #[cfg(target_arch = "x86_64")]
-            Self::Avx512 => 3,
-            _ => 6,
+            Self::Avx512 | Self::Avx2 => 3,
+            Self::Portable => 6,
         }
     }
 
@@ -893,19 +895,35 @@ impl<const N: usize> ManifoldBatch<N> {
         unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, L>>() }
     }
 
-    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes each.
+    /// Whether any of lanes 4–7 holds a manifold: the AVX2 path skips that half if not.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn upper_half_used(&self) -> bool {
+        self.first_point[LANES / 2..].iter().any(|&f| f != PAD)
+    }
+
+    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes: the
+    /// batch is solved half by half (its manifolds share no moving body, so each half is
+    /// solved as if alone), see `avx2`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        // SAFETY: this function runs only where the processor has AVX2 (`warm_start_on`).
-        unsafe { self.as_lanes::<F64x8Avx2>() }.warm_start_lanes(bodies)
+        // SAFETY (both): this function runs only where the processor has AVX2
+        // (`warm_start_on`).
+        unsafe { self.as_lanes::<HalfAvx2<0>>() }.warm_start_lanes(bodies);
+        if self.upper_half_used() {
+            unsafe { self.as_lanes::<HalfAvx2<1>>() }.warm_start_lanes(bodies);
+        }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        // SAFETY: this function runs only where the processor has AVX2 (`solve_on`).
-        unsafe { self.as_lanes_mut::<F64x8Avx2>() }.solve_lanes(bodies, pass)
+        // SAFETY (both): this function runs only where the processor has AVX2 (`solve_on`).
+        unsafe { self.as_lanes_mut::<HalfAvx2<0>>() }.solve_lanes(bodies, pass);
+        if self.upper_half_used() {
+            unsafe { self.as_lanes_mut::<HalfAvx2<1>>() }.solve_lanes(bodies, pass);
+        }
     }
 
     /// The same code compiled for AVX-512, whose 512-bit registers hold all eight lanes.
@@ -1169,7 +1187,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             let limit = self.friction * normal_impulse;
             let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
             let delta = total - p.tangent_impulse;
-            p.tangent_impulse = total;
+            p.tangent_impulse.set(total);
             pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
         }
         // SAFETY: checked above.
@@ -1212,12 +1230,14 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             solve_normals_alone(&mut alone, alone_points, normal, separations, targets);
             *pair = LanePair::select(mixed, alone, *pair);
             for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
-                *p = mixed.select(q, *p);
+                p.set(mixed.select(q, *p));
             }
             if let Some(bounce) = bounce {
                 for (p, q) in self.bounce.iter_mut().zip(bounce) {
-                    p.max_normal_impulse = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
-                    p.relative_velocity = mixed.select(q.relative_velocity, p.relative_velocity);
+                    let largest = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
+                    p.max_normal_impulse.set(largest);
+                    let fastest = mixed.select(q.relative_velocity, p.relative_velocity);
+                    p.relative_velocity.set(fastest);
                 }
             }
         }
@@ -1342,11 +1362,11 @@ fn apply_normal<L: Lanes>(
 ) {
     let total = total.max(L::splat(0.0));
     let delta = total - *impulse;
-    *impulse = total;
+    impulse.set(total);
     if let Some(b) = bounce {
         let elastic = b.restitution.ne(L::splat(0.0));
-        b.max_normal_impulse =
-            elastic.select(b.max_normal_impulse.max(delta), b.max_normal_impulse);
+        let largest = elastic.select(b.max_normal_impulse.max(delta), b.max_normal_impulse);
+        b.max_normal_impulse.set(largest);
     }
     pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, delta);
 }
@@ -1359,8 +1379,8 @@ fn approach<L: Lanes>(b: &mut LaneBounce<L>, vn: L, separation: L) {
     if may_bounce.any() {
         let gained = L::splat(2.0) * b.closing_acceleration * separation.max(zero);
         let impact = (-(vn * vn + gained.max(zero)).sqrt()).max(b.fastest_impact);
-        b.relative_velocity =
-            may_bounce.select(b.relative_velocity.min(impact), b.relative_velocity);
+        let fastest = may_bounce.select(b.relative_velocity.min(impact), b.relative_velocity);
+        b.relative_velocity.set(fastest);
     }
 }
 
@@ -1470,15 +1490,16 @@ mod tests {
         let mut n = Numbers(seed);
         let mut bodies: Vec<SoftBody> = (0..14).map(|_| body(&mut n, true)).collect();
         bodies.push(body(&mut n, false));
+        // The fixed body 14 in lanes 3 and 4: in both halves of the AVX2 path.
         let pairs = [
             (0, 1),
             (2, 3),
             (4, 5),
-            (6, 7),
+            (6, 14),
+            (14, 7),
             (8, 9),
             (10, 11),
-            (12, 14),
-            (14, 13),
+            (12, 13),
         ];
         let mut points = Vec::new();
         for (a, b) in pairs {

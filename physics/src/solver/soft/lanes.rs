@@ -1,6 +1,7 @@
 //! Eight f64 lanes, as the batches compute with them (`Lanes`): `F64x8`, plain arrays that
-//! the compiler vectorises, on any processor; `avx2::F64x8Avx2`, the same numbers in two
-//! 256-bit registers, inside the functions compiled for AVX2; and `avx512::F64x8Avx512`,
+//! the compiler vectorises, on any processor; `avx2::HalfAvx2`, half of them in a
+//! 256-bit register, inside the functions compiled for AVX2 (which solve a batch half by
+//! half); and `avx512::F64x8Avx512`,
 //! in one 512-bit register, inside those compiled for AVX-512 (chosen at run time, see
 //! `batch::LanePath::best`). Every lane rounds as the scalar code does, so all three give
 //! the same bits.
@@ -37,6 +38,12 @@ pub(super) trait Lanes:
     fn lt(self, rhs: Self) -> Self::Mask;
     fn eq(self, rhs: Self) -> Self::Mask;
     fn ne(self, rhs: Self) -> Self::Mask;
+    /// Writes `value` into a batch's field: every lane this type computes, and no other
+    /// (`avx2::HalfAvx2` computes half of them, and the other half must keep its numbers).
+    #[inline(always)]
+    fn set(&mut self, value: Self) {
+        *self = value;
+    }
     /// The row `row` of the bodies `index` names, one body a lane: its four numbers as
     /// four columns (`SoftBody::row`).
     ///
