@@ -783,8 +783,20 @@ fn machine() -> String {
         .lines()
         .find_map(|l| l.strip_prefix("model name")?.split_once(':'))
         .map_or("unknown CPU", |(_, m)| m.trim());
+    let field = |name: &str| {
+        info.lines()
+            .find_map(|l| l.strip_prefix(name)?.trim_start().strip_prefix(':'))
+            .map_or("?", str::trim)
+    };
     let cores = info.lines().filter(|l| l.starts_with("processor")).count();
-    format!("{model}, {cores} logical cores")
+    // Same-model names cover several generations (an EPYC with AVX-512 or without), and
+    // pe's batches run as wide as the processor allows.
+    format!(
+        "{model} (family {}, model {}), {cores} logical cores; pe's soft-step batches in {}",
+        field("cpu family"),
+        field("model"),
+        pe::solver::soft::lane_path_name()
+    )
 }
 
 /// The rapier2d version actually built, from this crate's lock file.

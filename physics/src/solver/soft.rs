@@ -25,6 +25,20 @@ mod avx512;
 mod batch;
 mod lanes;
 
+/// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
+/// (eight f64 lanes a register), "AVX2" (four, a batch half by half) or "portable"
+/// (plain arrays). The results are the same bits on each; the speed is not, so
+/// benchmarks name it beside the machine.
+pub fn lane_path_name() -> &'static str {
+    match LanePath::best() {
+        LanePath::Portable => "portable",
+        #[cfg(target_arch = "x86_64")]
+        LanePath::Avx2 => "AVX2",
+        #[cfg(target_arch = "x86_64")]
+        LanePath::Avx512 => "AVX-512",
+    }
+}
+
 /// Joint islands up to this many pins are solved as one linear system per pass (a dense
 /// Cholesky of 2m × 2m); larger ones pin by pin. One pass of pin-by-pin Gauss–Seidel
 /// cannot hold a light chain under a heavy load: the error travels one link per pass.
