@@ -4,8 +4,8 @@
 //! half by half: its manifolds share no moving body, so each half is solved as if alone,
 //! and a half whose lanes are all unused is skipped. All eight lanes at once, in two
 //! registers a row, spilled: the pair's velocities alone are sixteen registers, all that
-//! AVX2 has (a two-point batch's pass 666K against 564K instructions a step on the 20-row
-//! pyramid with four lanes, docs/bench/profile.md).
+//! AVX2 has (the batches' passes took 666K instructions a step on the 20-row pyramid
+//! against 564K with four lanes; docs/bench/profile.md, "A machine without AVX-512").
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
