@@ -779,22 +779,20 @@ fn machine() -> String {
     let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
         return "unknown (no /proc/cpuinfo)".into();
     };
-    let model = info
-        .lines()
-        .find_map(|l| l.strip_prefix("model name")?.split_once(':'))
-        .map_or("unknown CPU", |(_, m)| m.trim());
+    // `name: value`, as /proc/cpuinfo lists its fields ("model" is not "model name").
     let field = |name: &str| {
         info.lines()
             .find_map(|l| l.strip_prefix(name)?.trim_start().strip_prefix(':'))
-            .map_or("?", str::trim)
+            .map(str::trim)
     };
+    let model = field("model name").unwrap_or("unknown CPU");
     let cores = info.lines().filter(|l| l.starts_with("processor")).count();
     // Same-model names cover several generations (an EPYC with AVX-512 or without), and
     // pe's batches run as wide as the processor allows.
     format!(
         "{model} (family {}, model {}), {cores} logical cores; pe's soft-step batches in {}",
-        field("cpu family"),
-        field("model"),
+        field("cpu family").unwrap_or("?"),
+        field("model").unwrap_or("?"),
         pe::solver::soft::lane_path_name()
     )
 }

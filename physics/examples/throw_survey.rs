@@ -37,7 +37,7 @@ fn main() {
             substeps,
             &mut stepping,
         );
-        if outcome.depth > BOUND {
+        if outcome.sank() {
             let (a, b) = outcome.masses;
             // A fixed body (a wall, the floor) has no mass here.
             let ratio = if a.min(b) > 0.0 {

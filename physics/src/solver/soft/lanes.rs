@@ -1,9 +1,8 @@
 //! Eight f64 lanes, as the batches compute with them (`Lanes`): `F64x8`, plain arrays that
-//! the compiler vectorises, on any processor; `avx2::HalfAvx2`, half of them in a
-//! 256-bit register, inside the functions compiled for AVX2 (which solve a batch half by
-//! half); and `avx512::F64x8Avx512`,
-//! in one 512-bit register, inside those compiled for AVX-512 (chosen at run time, see
-//! `batch::LanePath::best`). Every lane rounds as the scalar code does, so all three give
+//! the compiler vectorises, on any processor; `avx2::HalfAvx2`, half of them in a 256-bit
+//! register, inside the functions compiled for AVX2 (which solve a batch half by half);
+//! and `avx512::F64x8Avx512`, all of them in one 512-bit register, inside those compiled
+//! for AVX-512 (chosen at run time, see `batch::LanePath::best`). Every lane rounds as the scalar code does, so all three give
 //! the same bits.
 
 use super::{BodyRow, SoftBody};
