@@ -364,6 +364,8 @@ pub struct SoftStepSolver {
     spare_joints: Vec<SoftJoint>,
     /// Last step's contact impulses, recalled as this step's points are built.
     memory: ContactMemory,
+    /// Each contact's impulses from the last step (`ContactMemory::recall`).
+    recalled: Vec<(f64, f64)>,
     joint_memory: JointMemory,
     /// The pinned bodies' rotations at the step's start, found as the pins need them.
     rotations: Vec<Option<Rot>>,
@@ -648,6 +650,11 @@ impl SoftStepSolver {
         self.points.truncate(contacts.len());
         self.plan_inputs.clear();
         self.may_bounce = false;
+        // The last impulses: a pile at rest has the same contacts in the same order, each
+        // its entry at its own index (`ContactMemory::guess`); at the first that is not,
+        // every contact's are recalled at once, in the contacts' order, which the
+        // memory's follows (the points are built in the islands').
+        let mut recalled_all = false;
         let mut skipped = false;
         // The manifold begun by the point before, not yet complete: its first point's
         // index, whether its island is small (below), and where in `pending` its point
@@ -655,7 +662,6 @@ impl SoftStepSolver {
         let mut open: Option<(usize, bool, usize)> = None;
         let mut pending = [PointConstraint::default(); 2];
         let mut next = 0;
-        let mut shift = 0; // `ContactMemory::recall_at`'s
         let mut last_contact = None; // (bodies, normal)
         // The island of the current point: where it ends, and whether it may be an LCP
         // island (`ContactLcp::prepare`), which reads its points.
@@ -694,7 +700,14 @@ impl SoftStepSolver {
                 let k = row_coupling(a.inv_mass + b.inv_mass, inertias, levers, levers);
                 if k > 0.0 { 1.0 / k } else { 0.0 }
             };
-            let (normal_impulse, tangent_impulse) = self.memory.recall_at(i, c, &mut shift);
+            let guessed = (!recalled_all).then(|| self.memory.guess(i, c)).flatten();
+            let (normal_impulse, tangent_impulse) = guessed.unwrap_or_else(|| {
+                if !recalled_all {
+                    self.memory.recall(contacts, &mut self.recalled);
+                    recalled_all = true;
+                }
+                self.recalled[i]
+            });
             self.may_bounce |= c.restitution != 0.0;
             // Read only for points that may bounce (`approach`).
             let closing_acceleration = if c.restitution == 0.0 {
