@@ -34,9 +34,9 @@ impl ContactMemory {
     /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
     /// the order of `contacts`.
     ///
-    /// Both lists come by body pair in increasing order, and a pile at rest has the same
-    /// contacts in the same order: each is looked for first at the entry after the last
-    /// one found, then among its pair's entries, found a few entries on or else by a
+    /// Both lists come by body pair in increasing order, and most contacts are the last
+    /// step's: each is looked for first where the last one's search ended (after the
+    /// entry found), then among its pair's entries, found a few entries on or else by a
     /// binary search. (Searched for contact by contact, in the islands' order, the smash's
     /// contacts, which come and go, spent a quarter of building their points searching.)
     pub fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {
@@ -285,6 +285,18 @@ mod tests {
             .collect()
     }
 
+    /// Each of `now`'s impulses in `last`, found by a search of all of it: what
+    /// `ContactMemory::recall` must give.
+    fn searched(last: &[Contact], now: &[Contact]) -> Vec<(f64, f64)> {
+        now.iter()
+            .map(|c| {
+                last.iter()
+                    .find(|m| (m.body_a, m.body_b, m.id) == (c.body_a, c.body_b, c.id))
+                    .map_or((0.0, 0.0), |m| (m.normal_impulse, m.tangent_impulse))
+            })
+            .collect()
+    }
+
     /// Every contact finds its own last impulses and a new one zeros, as a search of the
     /// whole memory finds them: contacts gone, come, reordered within a pair, and a pair
     /// out of order.
@@ -320,15 +332,7 @@ mod tests {
         );
         let mut recalled = vec![];
         memory.recall(&now, &mut recalled);
-        let searched: Vec<(f64, f64)> = now
-            .iter()
-            .map(|c| {
-                last.iter()
-                    .find(|m| (m.body_a, m.body_b, m.id) == (c.body_a, c.body_b, c.id))
-                    .map_or((0.0, 0.0), |m| (m.normal_impulse, m.tangent_impulse))
-            })
-            .collect();
-        assert_eq!(recalled, searched);
+        assert_eq!(recalled, searched(&last, &now));
         let found = recalled.iter().filter(|r| r.0 != 0.0).count();
         assert_eq!(found, 6, "{recalled:?}");
         memory.recall(&[], &mut recalled);
@@ -373,7 +377,8 @@ mod tests {
             .collect();
         now_keys.sort_by_key(|&(a, b, _)| (a, b));
         for k in 1..now_keys.len() {
-            if now_keys[k - 1].0 == now_keys[k].0 && next(2) == 0 {
+            let pair = |k: usize| (now_keys[k].0, now_keys[k].1);
+            if pair(k - 1) == pair(k) && next(2) == 0 {
                 now_keys.swap(k - 1, k); // a pair's features the other way round
             }
         }
@@ -383,15 +388,7 @@ mod tests {
         let now = contacts(&now_keys, 0.0);
         let mut recalled = vec![];
         memory.recall(&now, &mut recalled);
-        let searched: Vec<(f64, f64)> = now
-            .iter()
-            .map(|c| {
-                last.iter()
-                    .find(|m| (m.body_a, m.body_b, m.id) == (c.body_a, c.body_b, c.id))
-                    .map_or((0.0, 0.0), |m| (m.normal_impulse, m.tangent_impulse))
-            })
-            .collect();
-        assert_eq!(recalled, searched);
+        assert_eq!(recalled, searched(&last, &now));
         let found = recalled.iter().filter(|r| r.0 != 0.0).count();
         assert!(
             found > 1000 && found < now.len() - 1000,
