@@ -26,7 +26,7 @@ mod batch;
 mod lanes;
 
 /// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
-/// (eight f64 lanes a register), "AVX2" (four, a batch half by half) or "portable"
+/// (eight f64 lanes a register), "AVX2" (four, a row of eight in two) or "portable"
 /// (plain arrays). The results are the same bits on each; the speed is not, so
 /// benchmarks name it beside the machine.
 pub fn lane_path_name() -> &'static str {
@@ -111,7 +111,7 @@ impl Softness {
 
 /// A body during the soft step: velocity, inverse mass, and how far it moved this step.
 ///
-/// Laid out for the batches' SIMD paths (`avx2::HalfAvx2::gather`, `avx512`), which read
+/// Laid out for the batches' SIMD paths (`avx2::Avx2Lanes::gather`, `avx512`), which read
 /// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
 /// transpose them into lanes: the two rows start at 0 and 32 bytes, and a body is
 /// 32-byte aligned.

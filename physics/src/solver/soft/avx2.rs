@@ -1,51 +1,60 @@
-//! Half of a batch's eight lanes in one AVX2 register (`Lanes` for `HalfAvx2<H>`: lanes
-//! 0–3 for `H = 0`, 4–7 for `H = 1`), for the functions compiled with
-//! `#[target_feature(enable = "avx2")]` and nothing else. Those functions solve a batch
-//! half by half: its manifolds share no moving body, so each half is solved as if alone,
-//! and a half whose lanes are all unused is skipped. All eight lanes at once, in two
-//! registers a row, spilled: the pair's velocities alone are sixteen registers, all that
-//! AVX2 has (the batches' passes took 666K instructions a step on the 20-row pyramid
-//! against 564K with four lanes; docs/bench/profile.md, "A machine without AVX-512").
+//! A batch's eight lanes in AVX2 registers, four to a register (`Avx2Lanes`), for the
+//! functions compiled with `#[target_feature(enable = "avx2")]` and nothing else. A row of
+//! eight lanes is two registers, its halves (lanes 0–3 and 4–7); a type computes the
+//! halves `FIRST..END` of them and leaves the others alone:
+//!
+//! - `BothHalves` solves a full batch's passes: the two halves' manifolds share no moving
+//!   body, so their chains of dependent updates are independent, and interleaved they
+//!   keep the processor busy where one half alone waits on each result (docs/bench/
+//!   profile.md, "Both halves at once").
+//! - `LowerHalf` and `UpperHalf` solve a batch half by half: the warm start, whose short
+//!   chain gains nothing from interleaving and pays for the registers it spills, and a
+//!   batch whose upper half is unused, which is then skipped.
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
 //! { b }`, comparisons are ordered (false on NaN) except `!=`, and there is no fused
 //! multiply–add.
 //!
-//! Only a function compiled for AVX2 may use this type, and only once the processor is
-//! known to have AVX2: its operations are `#[inline(always)]` wrappers of intrinsics that
-//! become single instructions when inlined there.
+//! Only a function compiled for AVX2 may use these types, and only once the processor is
+//! known to have AVX2: their operations are `#[inline(always)]` wrappers of intrinsics
+//! that become single instructions when inlined there.
 
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
 
-/// Lanes `4H..4H + 4` of a batch's eight, read from and written to their half of an
-/// `F64x8` (the same size, layout and alignment). A value computed here carries its lanes
-/// in both halves; only `set` writes into a batch, and only this half, so that solving
-/// one half leaves the other's numbers as they were.
+/// Lanes `4 FIRST..4 END` of a batch's eight, read from and written to their halves of an
+/// `F64x8` (the same size, layout and alignment). The halves outside `FIRST..END` of a
+/// computed value hold nothing meaningful; only `set` writes into a batch, and only the
+/// computed halves, so that solving one half leaves the other's numbers as they were.
 #[derive(Debug, Clone, Copy)]
 #[repr(C, align(64))]
-pub(super) struct HalfAvx2<const H: usize>([__m256d; 2]);
+pub(super) struct Avx2Lanes<const FIRST: usize, const END: usize>([__m256d; 2]);
 
-/// A lane-wise condition of a half: all ones or all zeros per lane.
+/// All eight lanes, both halves interleaved.
+pub(super) type BothHalves = Avx2Lanes<0, 2>;
+/// Lanes 0–3.
+pub(super) type LowerHalf = Avx2Lanes<0, 1>;
+/// Lanes 4–7.
+pub(super) type UpperHalf = Avx2Lanes<1, 2>;
+
+/// A lane-wise condition of the same halves: all ones or all zeros per lane.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct HalfMaskAvx2(__m256d);
+pub(super) struct Avx2Mask<const FIRST: usize, const END: usize>([__m256d; 2]);
 
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<HalfAvx2<0>>() == size_of::<F64x8>());
-    assert!(align_of::<HalfAvx2<0>>() == align_of::<F64x8>());
-    assert!(size_of::<HalfAvx2<1>>() == size_of::<F64x8>());
-    assert!(align_of::<HalfAvx2<1>>() == align_of::<F64x8>());
+    assert!(size_of::<BothHalves>() == size_of::<F64x8>());
+    assert!(align_of::<BothHalves>() == align_of::<F64x8>());
 };
 
 /// Lanes a half holds.
 const HALF: usize = LANES / 2;
 
-// SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions this
-// type is used in are compiled for and only called with (`ManifoldBatch::as_lanes`); the
+// SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions these
+// types are used in are compiled for and only called with (`ManifoldBatch::as_lanes`); the
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
 // inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`, and
 // the bodies lie inside the slice (`Lanes::gather`'s precondition).
@@ -82,29 +91,29 @@ fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
-impl<const H: usize> HalfAvx2<H> {
-    /// This half's lanes.
-    #[inline(always)]
-    fn lanes(self) -> __m256d {
-        self.0[H]
-    }
-
-    /// A value with `lanes` as this half's (in both halves: see the type).
-    #[inline(always)]
-    fn of(lanes: __m256d) -> Self {
-        Self([lanes; 2])
-    }
-
-    /// `f` on this half's lanes of `a` and `b`.
+impl<const FIRST: usize, const END: usize> Avx2Lanes<FIRST, END> {
+    /// `f` on the computed halves of `a` and `b` (the others are `a`'s, unread).
     #[inline(always)]
     fn zip(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> Self {
-        Self::of(f(a.lanes(), b.lanes()))
+        Self(std::array::from_fn(|h| {
+            if (FIRST..END).contains(&h) {
+                f(a.0[h], b.0[h])
+            } else {
+                a.0[h]
+            }
+        }))
     }
 
-    /// The comparison `f` on this half's lanes, as a mask.
+    /// `f` on each computed half.
     #[inline(always)]
-    fn compare(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> HalfMaskAvx2 {
-        HalfMaskAvx2(f(a.lanes(), b.lanes()))
+    fn map(self, f: impl Fn(__m256d) -> __m256d) -> Self {
+        Self::zip(self, self, |a, _| f(a))
+    }
+
+    /// The comparison `f` on the computed halves, as a mask.
+    #[inline(always)]
+    fn compare(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> Avx2Mask<FIRST, END> {
+        Avx2Mask(Self::zip(a, b, f).0)
     }
 
     /// `if lo > self { lo } else { self }`, the lower bound of `clamp`.
@@ -114,12 +123,13 @@ impl<const H: usize> HalfAvx2<H> {
     }
 }
 
-impl<const H: usize> Lanes for HalfAvx2<H> {
-    type Mask = HalfMaskAvx2;
+impl<const FIRST: usize, const END: usize> Lanes for Avx2Lanes<FIRST, END> {
+    type Mask = Avx2Mask<FIRST, END>;
 
     #[inline(always)]
     fn splat(x: f64) -> Self {
-        Self::of(unsafe { _mm256_set1_pd(x) })
+        let lanes = unsafe { _mm256_set1_pd(x) };
+        Self([lanes; 2])
     }
 
     #[inline(always)]
@@ -139,56 +149,65 @@ impl<const H: usize> Lanes for HalfAvx2<H> {
 
     #[inline(always)]
     fn sqrt(self) -> Self {
-        Self::of(unsafe { _mm256_sqrt_pd(self.lanes()) })
+        self.map(|a| unsafe { _mm256_sqrt_pd(a) })
     }
 
     #[inline(always)]
-    fn gt(self, rhs: Self) -> HalfMaskAvx2 {
+    fn gt(self, rhs: Self) -> Self::Mask {
         Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_GT_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn ge(self, rhs: Self) -> HalfMaskAvx2 {
+    fn ge(self, rhs: Self) -> Self::Mask {
         Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_GE_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn lt(self, rhs: Self) -> HalfMaskAvx2 {
+    fn lt(self, rhs: Self) -> Self::Mask {
         Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_LT_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn eq(self, rhs: Self) -> HalfMaskAvx2 {
+    fn eq(self, rhs: Self) -> Self::Mask {
         Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_EQ_OQ>(a, b)
         })
     }
 
     #[inline(always)]
-    fn ne(self, rhs: Self) -> HalfMaskAvx2 {
+    fn ne(self, rhs: Self) -> Self::Mask {
         Self::compare(self, rhs, |a, b| unsafe {
             _mm256_cmp_pd::<_CMP_NEQ_UQ>(a, b)
         })
     }
 
-    /// This half's lanes only: the other half of `self` keeps its numbers.
+    /// The computed halves only: the others keep their numbers.
     #[inline(always)]
     fn set(&mut self, value: Self) {
-        self.0[H] = value.lanes();
+        for h in FIRST..END {
+            self.0[h] = value.0[h];
+        }
     }
 
     #[inline(always)]
     unsafe fn gather(bodies: &[SoftBody], index: &[u32; LANES], which: BodyRow) -> [Self; 4] {
-        // Written out: `array::map` was left out of line here.
-        let load = |k: usize| unsafe { _mm256_load_pd(row(bodies, index[H * HALF + k], which)) };
-        let [c0, c1, c2, c3] = transpose([load(0), load(1), load(2), load(3)]);
-        [Self::of(c0), Self::of(c1), Self::of(c2), Self::of(c3)]
+        let mut columns = [Self::splat(0.0); 4];
+        for h in FIRST..END {
+            // Written out: `array::map` was left out of line here.
+            let load =
+                |k: usize| unsafe { _mm256_load_pd(row(bodies, index[h * HALF + k], which)) };
+            let half = transpose([load(0), load(1), load(2), load(3)]);
+            for (column, lanes) in columns.iter_mut().zip(half) {
+                column.0[h] = lanes;
+            }
+        }
+        columns
     }
 
     #[inline(always)]
@@ -197,45 +216,68 @@ impl<const H: usize> Lanes for HalfAvx2<H> {
         bodies: &mut [SoftBody],
         index: &[u32; LANES],
     ) {
-        let [c0, c1, c2, c3] = columns.map(Self::lanes);
-        for (k, row) in transpose([c0, c1, c2, c3]).into_iter().enumerate() {
-            let at = row_mut(bodies, index[H * HALF + k], BodyRow::Velocity);
-            unsafe { _mm256_store_pd(at, row) };
+        for h in FIRST..END {
+            let [c0, c1, c2, c3] = columns.map(|c| c.0[h]);
+            for (k, row) in transpose([c0, c1, c2, c3]).into_iter().enumerate() {
+                let at = row_mut(bodies, index[h * HALF + k], BodyRow::Velocity);
+                unsafe { _mm256_store_pd(at, row) };
+            }
         }
     }
 }
 
-impl<const H: usize> LaneMask<HalfAvx2<H>> for HalfMaskAvx2 {
+impl<const FIRST: usize, const END: usize> LaneMask<Avx2Lanes<FIRST, END>>
+    for Avx2Mask<FIRST, END>
+{
     #[inline(always)]
     fn any(self) -> bool {
-        unsafe { _mm256_movemask_pd(self.0) != 0 }
+        (FIRST..END).any(|h| unsafe { _mm256_movemask_pd(self.0[h]) != 0 })
     }
 
     #[inline(always)]
-    fn select(self, if_true: HalfAvx2<H>, if_false: HalfAvx2<H>) -> HalfAvx2<H> {
-        HalfAvx2::of(unsafe { _mm256_blendv_pd(if_false.lanes(), if_true.lanes(), self.0) })
+    fn select(
+        self,
+        if_true: Avx2Lanes<FIRST, END>,
+        if_false: Avx2Lanes<FIRST, END>,
+    ) -> Avx2Lanes<FIRST, END> {
+        Avx2Lanes(std::array::from_fn(|h| {
+            let (f, t) = (if_false.0[h], if_true.0[h]);
+            if (FIRST..END).contains(&h) {
+                unsafe { _mm256_blendv_pd(f, t, self.0[h]) }
+            } else {
+                f
+            }
+        }))
     }
 }
 
-impl BitAnd for HalfMaskAvx2 {
+impl<const FIRST: usize, const END: usize> BitAnd for Avx2Mask<FIRST, END> {
     type Output = Self;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_and_pd(self.0, rhs.0) })
+        let both =
+            Avx2Lanes::<FIRST, END>::zip(Avx2Lanes(self.0), Avx2Lanes(rhs.0), |a, b| unsafe {
+                _mm256_and_pd(a, b)
+            });
+        Self(both.0)
     }
 }
 
-impl BitXor for HalfMaskAvx2 {
+impl<const FIRST: usize, const END: usize> BitXor for Avx2Mask<FIRST, END> {
     type Output = Self;
     #[inline(always)]
     fn bitxor(self, rhs: Self) -> Self {
-        Self(unsafe { _mm256_xor_pd(self.0, rhs.0) })
+        let either =
+            Avx2Lanes::<FIRST, END>::zip(Avx2Lanes(self.0), Avx2Lanes(rhs.0), |a, b| unsafe {
+                _mm256_xor_pd(a, b)
+            });
+        Self(either.0)
     }
 }
 
 macro_rules! lane_op {
     ($trait:ident, $method:ident, $assign_trait:ident, $assign:ident, $intrinsic:ident) => {
-        impl<const H: usize> $trait for HalfAvx2<H> {
+        impl<const FIRST: usize, const END: usize> $trait for Avx2Lanes<FIRST, END> {
             type Output = Self;
             #[inline(always)]
             fn $method(self, rhs: Self) -> Self {
@@ -243,7 +285,7 @@ macro_rules! lane_op {
             }
         }
 
-        impl<const H: usize> $assign_trait for HalfAvx2<H> {
+        impl<const FIRST: usize, const END: usize> $assign_trait for Avx2Lanes<FIRST, END> {
             #[inline(always)]
             fn $assign(&mut self, rhs: Self) {
                 *self = Self::zip(*self, rhs, |a, b| unsafe { $intrinsic(a, b) });
@@ -255,7 +297,7 @@ macro_rules! lane_op {
 lane_op!(Add, add, AddAssign, add_assign, _mm256_add_pd);
 lane_op!(Sub, sub, SubAssign, sub_assign, _mm256_sub_pd);
 
-impl<const H: usize> Mul for HalfAvx2<H> {
+impl<const FIRST: usize, const END: usize> Mul for Avx2Lanes<FIRST, END> {
     type Output = Self;
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
@@ -263,12 +305,12 @@ impl<const H: usize> Mul for HalfAvx2<H> {
     }
 }
 
-impl<const H: usize> Neg for HalfAvx2<H> {
+impl<const FIRST: usize, const END: usize> Neg for Avx2Lanes<FIRST, END> {
     type Output = Self;
     /// The sign bit flipped, as `-x` does.
     #[inline(always)]
     fn neg(self) -> Self {
         let sign = unsafe { _mm256_set1_pd(-0.0) };
-        Self::of(unsafe { _mm256_xor_pd(self.lanes(), sign) })
+        self.map(|a| unsafe { _mm256_xor_pd(a, sign) })
     }
 }

@@ -18,7 +18,7 @@
 //! 0.25% of a box over 500 steps (Box2D v3 0.94%): see docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
-use super::avx2::HalfAvx2;
+use super::avx2::{BothHalves, LowerHalf, UpperHalf};
 #[cfg(target_arch = "x86_64")]
 use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
@@ -622,7 +622,7 @@ struct LaneBounce<L = F64x8> {
 /// Eight manifolds of `N` points (one or two) with no moving body in common, their data
 /// lane by lane; each manifold's points stay in `points` too, which this batch updates at
 /// the end of the substeps. Stored with `F64x8` lanes; `repr(C)`, so that the AVX2 and
-/// AVX-512 paths read the same bytes as `ManifoldBatch<N, HalfAvx2<H>>` and
+/// AVX-512 paths read the same bytes as `ManifoldBatch<N, Avx2Lanes<FIRST, END>>` and
 /// `ManifoldBatch<N, F64x8Avx512>`.
 #[derive(Debug, Clone, Copy)]
 #[repr(C)]
@@ -660,10 +660,10 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
 #[cfg(target_arch = "x86_64")]
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, HalfAvx2<1>>>());
-    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, HalfAvx2<1>>>());
-    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, HalfAvx2<1>>>());
-    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, HalfAvx2<1>>>());
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, UpperHalf>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, UpperHalf>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, UpperHalf>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, UpperHalf>>());
     assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx512>>());
     assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx512>>());
     assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx512>>());
@@ -785,7 +785,7 @@ pub(super) struct PassSettings {
 pub(super) enum LanePath {
     /// `F64x8`: plain arrays, any processor.
     Portable,
-    /// `HalfAvx2`: a 256-bit register, a batch solved half by half.
+    /// `Avx2Lanes`: four lanes to a 256-bit register, a row in two.
     #[cfg(target_arch = "x86_64")]
     Avx2,
     /// `F64x8Avx512`: one 512-bit register.
@@ -902,27 +902,29 @@ impl<const N: usize> ManifoldBatch<N> {
         self.first_point[LANES / 2..].iter().any(|&f| f != PAD)
     }
 
-    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes: the
-    /// batch is solved half by half (its manifolds share no moving body, so each half is
-    /// solved as if alone), see `avx2`.
+    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes. The
+    /// warm start goes half by half (its manifolds share no moving body, so each half is
+    /// as if alone), skipping an unused upper half; see `avx2`.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
         // SAFETY (both): this function runs only where the processor has AVX2
         // (`warm_start_on`).
-        unsafe { self.as_lanes::<HalfAvx2<0>>() }.warm_start_lanes(bodies);
+        unsafe { self.as_lanes::<LowerHalf>() }.warm_start_lanes(bodies);
         if self.upper_half_used() {
-            unsafe { self.as_lanes::<HalfAvx2<1>>() }.warm_start_lanes(bodies);
+            unsafe { self.as_lanes::<UpperHalf>() }.warm_start_lanes(bodies);
         }
     }
 
+    /// A pass solves both halves at once, interleaved, unless the upper one is unused.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
         // SAFETY (both): this function runs only where the processor has AVX2 (`solve_on`).
-        unsafe { self.as_lanes_mut::<HalfAvx2<0>>() }.solve_lanes(bodies, pass);
         if self.upper_half_used() {
-            unsafe { self.as_lanes_mut::<HalfAvx2<1>>() }.solve_lanes(bodies, pass);
+            unsafe { self.as_lanes_mut::<BothHalves>() }.solve_lanes(bodies, pass);
+        } else {
+            unsafe { self.as_lanes_mut::<LowerHalf>() }.solve_lanes(bodies, pass);
         }
     }
 
@@ -1776,6 +1778,44 @@ mod tests {
                 let expected = state(&one_by_one, &their_points);
                 let label = format!("seed {seed}, bias {use_bias}");
                 assert_batch_gives::<2>((&bodies, &points), firsts, &pass, &expected, &label);
+            }
+        }
+    }
+
+    /// On the AVX2 path, a pass on a batch whose upper half is unused writes only the
+    /// lower half's lanes (`Lanes::set`): what it computes for the half it skips is
+    /// garbage. (The other paths solve the unused lanes as manifolds of the null body.)
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn a_pass_leaves_the_lanes_of_an_unused_half_as_they_were() {
+        if !LanePath::available().contains(&LanePath::Avx2) {
+            return;
+        }
+        const MARK: f64 = 7.0;
+        let written = |batch: &ManifoldBatch<2>| -> Vec<[f64; LANES]> {
+            let impulses = batch.normal_impulses.iter().map(|lanes| lanes.0);
+            let tangents = batch.points.iter().map(|p| p.tangent_impulse.0);
+            let bounces = batch.bounce.iter();
+            let bounces = bounces.flat_map(|b| [b.relative_velocity.0, b.max_normal_impulse.0]);
+            impulses.chain(tangents).chain(bounces).collect()
+        };
+        let mark = |lanes: &mut F64x8| lanes.0[LANES / 2..].fill(MARK);
+        for seed in 1..=20u64 {
+            let (mut bodies, points) = eight_manifolds_both_ways(seed);
+            bodies.push(SoftBody::null());
+            let mut batch = ManifoldBatch::<2>::default();
+            batch.fill([0, 2, 4, PAD, PAD, PAD, PAD, PAD], &points, &bodies);
+            batch.normal_impulses.iter_mut().for_each(mark);
+            for p in &mut batch.points {
+                mark(&mut p.tangent_impulse);
+            }
+            for b in &mut batch.bounce {
+                mark(&mut b.relative_velocity);
+                mark(&mut b.max_normal_impulse);
+            }
+            batch.solve_on(LanePath::Avx2, &mut bodies, &pass(true));
+            for lanes in written(&batch) {
+                assert_eq!(lanes[LANES / 2..], [MARK; 4], "seed {seed}");
             }
         }
     }

@@ -1,9 +1,9 @@
 //! Eight f64 lanes, as the batches compute with them (`Lanes`): `F64x8`, plain arrays that
-//! the compiler vectorises, on any processor; `avx2::HalfAvx2`, half of them in a 256-bit
-//! register, inside the functions compiled for AVX2 (which solve a batch half by half);
-//! and `avx512::F64x8Avx512`, all of them in one 512-bit register, inside those compiled
-//! for AVX-512 (chosen at run time, see `batch::LanePath::best`). Every lane rounds as the scalar code does, so all three give
-//! the same bits.
+//! the compiler vectorises, on any processor; `avx2::Avx2Lanes`, four of them to a 256-bit
+//! register, both halves of a row or one, inside the functions compiled for AVX2; and
+//! `avx512::F64x8Avx512`, all of them in one 512-bit register, inside those compiled for
+//! AVX-512 (chosen at run time, see `batch::LanePath::best`). Every lane rounds as the
+//! scalar code does, so all three give the same bits.
 
 use super::{BodyRow, SoftBody};
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
@@ -38,7 +38,7 @@ pub(super) trait Lanes:
     fn eq(self, rhs: Self) -> Self::Mask;
     fn ne(self, rhs: Self) -> Self::Mask;
     /// Writes `value` into a batch's field: every lane this type computes, and no other
-    /// (`avx2::HalfAvx2` computes half of them, and the other half must keep its numbers).
+    /// (`avx2::LowerHalf` computes half of them, and the other half must keep its numbers).
     #[inline(always)]
     fn set(&mut self, value: Self) {
         *self = value;
