@@ -21,11 +21,14 @@ pub fn collide_polygons(
     margin: f64,
     tie_tolerance: f64,
 ) -> Option<Manifold> {
-    let (edge_a, separation_a) = separation_beyond(a, b, margin);
+    let (edge_a, separation_a) = separation_beyond(a, b, f64::NEG_INFINITY, margin);
     if separation_a > margin {
         return None;
     }
-    let (edge_b, separation_b) = separation_beyond(b, a, margin);
+    // B's edges matter only if one separates by more than A's best could be replaced by,
+    // or than the margin: the search need not find B's best below that.
+    let floor = (separation_a + tie_tolerance).min(margin);
+    let (edge_b, separation_b) = separation_beyond(b, a, floor, margin);
     if separation_b > margin {
         return None;
     }
@@ -74,13 +77,14 @@ pub fn collide_polygons(
 /// The edge of `p` whose outward normal separates `q` most, and that separation
 /// (negative = overlap). Earlier edges win ties.
 pub(super) fn max_separation(p: &WorldPolygon, q: &WorldPolygon) -> (usize, f64) {
-    separation_beyond(p, q, f64::INFINITY)
+    separation_beyond(p, q, f64::NEG_INFINITY, f64::INFINITY)
 }
 
-/// `max_separation`, except that it may stop at the first edge that separates by more
-/// than `enough` (the pair is then apart, whichever edge separates most).
-fn separation_beyond(p: &WorldPolygon, q: &WorldPolygon, enough: f64) -> (usize, f64) {
-    let mut best = (0, f64::NEG_INFINITY);
+/// `max_separation` where it is above `floor` (else `floor`, with edge 0), except that it
+/// may stop at the first edge that separates by more than `enough` (the pair is then
+/// apart, whichever edge separates most).
+fn separation_beyond(p: &WorldPolygon, q: &WorldPolygon, floor: f64, enough: f64) -> (usize, f64) {
+    let mut best = (0, floor);
     for (i, (n, v)) in p.normals.iter().zip(&p.vertices).enumerate() {
         let mut separation = f64::INFINITY;
         for w in &q.vertices {
@@ -414,5 +418,51 @@ mod tests {
             m.points().iter().map(|p| p.id).collect()
         };
         assert_eq!(ids(0.05), ids(0.08));
+    }
+
+    /// A regular polygon of `sides` and circumradius `radius`.
+    fn regular(sides: usize, radius: f64, at: (f64, f64), angle: f64) -> WorldPolygon {
+        let corners: Vec<(f64, f64)> = (0..sides)
+            .map(|k| std::f64::consts::TAU * k as f64 / sides as f64)
+            .map(|t| (radius * t.cos(), radius * t.sin()))
+            .collect();
+        poly(&corners, at, angle)
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config {
+            cases: 2000,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(2026),
+            failure_persistence: None,
+            ..proptest::test_runner::Config::default()
+        })]
+
+        /// B's edges are searched only above what could replace A's best edge (or part
+        /// them): the outcome is the full search's, each polygon's best edge over all of
+        /// them, chosen by the rule of `collide_polygons`.
+        #[test]
+        fn the_reference_edge_is_the_full_searchs(
+            sides in (3usize..7, 3usize..7),
+            radii in (0.2f64..1.5, 0.2f64..1.5),
+            offset in (-2.5f64..2.5, -2.5f64..2.5),
+            angles in (0.0f64..6.3, 0.0f64..6.3),
+            margin in proptest::sample::select(vec![0.0, 0.05, 0.3]),
+            tie_tolerance in proptest::sample::select(vec![1e-9, 0.02, 0.5]),
+        ) {
+            let a = regular(sides.0, radii.0, (0.0, 0.0), angles.0);
+            let b = regular(sides.1, radii.1, offset, angles.1);
+            let (edge_a, separation_a) = max_separation(&a, &b);
+            let (edge_b, separation_b) = max_separation(&b, &a);
+            let found = collide_polygons((A, &a), (B, &b), margin, tie_tolerance);
+            if separation_a > margin || separation_b > margin {
+                proptest::prop_assert!(found.is_none());
+            } else {
+                let m = found.expect("within the margin");
+                let reference_is_b = separation_b > separation_a + tie_tolerance;
+                let normal = if reference_is_b { b.normals[edge_b] } else { -a.normals[edge_a] };
+                proptest::prop_assert_eq!(m.reference_is_b, reference_is_b);
+                proptest::prop_assert_eq!(m.normal, normal);
+            }
+        }
     }
 }
