@@ -25,8 +25,8 @@ pub fn collide_polygons(
     if separation_a > margin {
         return None;
     }
-    // B's edges matter only if one separates by more than A's best could be replaced by,
-    // or than the margin: the search need not find B's best below that.
+    // B's best edge matters only if it beats A's by the tie tolerance or parts the pair
+    // (beyond the margin): below the lower of the two, B's search need not find it.
     let floor = (separation_a + tie_tolerance).min(margin);
     let (edge_b, separation_b) = separation_beyond(b, a, floor, margin);
     if separation_b > margin {
