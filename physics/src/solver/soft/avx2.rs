@@ -91,17 +91,27 @@ fn row_mut(bodies: &mut [SoftBody], index: u32, row: BodyRow) -> *mut f64 {
     body.cast::<f64>().wrapping_add(SoftBody::row_offset(row))
 }
 
+/// `computed(h)` for the halves `FIRST..END`, `rest`'s own elsewhere (unread): the one
+/// place that decides which halves an operation computes.
+#[inline(always)]
+fn on_halves<const FIRST: usize, const END: usize>(
+    rest: [__m256d; 2],
+    computed: impl Fn(usize) -> __m256d,
+) -> [__m256d; 2] {
+    std::array::from_fn(|h| {
+        if (FIRST..END).contains(&h) {
+            computed(h)
+        } else {
+            rest[h]
+        }
+    })
+}
+
 impl<const FIRST: usize, const END: usize> Avx2Lanes<FIRST, END> {
     /// `f` on the computed halves of `a` and `b` (the others are `a`'s, unread).
     #[inline(always)]
     fn zip(a: Self, b: Self, f: impl Fn(__m256d, __m256d) -> __m256d) -> Self {
-        Self(std::array::from_fn(|h| {
-            if (FIRST..END).contains(&h) {
-                f(a.0[h], b.0[h])
-            } else {
-                a.0[h]
-            }
-        }))
+        Self(on_halves::<FIRST, END>(a.0, |h| f(a.0[h], b.0[h])))
     }
 
     /// `f` on each computed half.
@@ -240,13 +250,8 @@ impl<const FIRST: usize, const END: usize> LaneMask<Avx2Lanes<FIRST, END>>
         if_true: Avx2Lanes<FIRST, END>,
         if_false: Avx2Lanes<FIRST, END>,
     ) -> Avx2Lanes<FIRST, END> {
-        Avx2Lanes(std::array::from_fn(|h| {
-            let (f, t) = (if_false.0[h], if_true.0[h]);
-            if (FIRST..END).contains(&h) {
-                unsafe { _mm256_blendv_pd(f, t, self.0[h]) }
-            } else {
-                f
-            }
+        Avx2Lanes(on_halves::<FIRST, END>(if_false.0, |h| unsafe {
+            _mm256_blendv_pd(if_false.0[h], if_true.0[h], self.0[h])
         }))
     }
 }
@@ -255,11 +260,9 @@ impl<const FIRST: usize, const END: usize> BitAnd for Avx2Mask<FIRST, END> {
     type Output = Self;
     #[inline(always)]
     fn bitand(self, rhs: Self) -> Self {
-        let both =
-            Avx2Lanes::<FIRST, END>::zip(Avx2Lanes(self.0), Avx2Lanes(rhs.0), |a, b| unsafe {
-                _mm256_and_pd(a, b)
-            });
-        Self(both.0)
+        Self(on_halves::<FIRST, END>(self.0, |h| unsafe {
+            _mm256_and_pd(self.0[h], rhs.0[h])
+        }))
     }
 }
 
@@ -267,11 +270,9 @@ impl<const FIRST: usize, const END: usize> BitXor for Avx2Mask<FIRST, END> {
     type Output = Self;
     #[inline(always)]
     fn bitxor(self, rhs: Self) -> Self {
-        let either =
-            Avx2Lanes::<FIRST, END>::zip(Avx2Lanes(self.0), Avx2Lanes(rhs.0), |a, b| unsafe {
-                _mm256_xor_pd(a, b)
-            });
-        Self(either.0)
+        Self(on_halves::<FIRST, END>(self.0, |h| unsafe {
+            _mm256_xor_pd(self.0[h], rhs.0[h])
+        }))
     }
 }
 
