@@ -17,6 +17,7 @@ use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
 use batch::{LanePath, PassItem, PassPlan, PassSettings, PlanInput};
+use pins::{PinPass, PinPlan};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -24,6 +25,7 @@ mod avx2;
 mod avx512;
 mod batch;
 mod lanes;
+mod pins;
 
 /// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
 /// (eight f64 lanes a register), "AVX2" (four, a row of eight in two) or "portable"
@@ -375,6 +377,8 @@ pub struct SoftStepSolver {
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
     joint_islands: Vec<(usize, usize)>,
+    /// The big pin islands' batches (`pins`).
+    pin_plan: PinPlan,
     /// The contacts' islands, kept while the contacts stay between the same bodies.
     contact_grouping: IslandGrouping,
     /// The pins' islands.
@@ -505,6 +509,7 @@ impl SoftStepSolver {
             self.plan.scatter(&mut self.points);
             self.restitution(bounce_below);
         }
+        self.pin_plan.scatter(&mut self.joints);
         self.store(bodies, contacts, joints);
         self.report();
     }
@@ -625,6 +630,8 @@ impl SoftStepSolver {
             .enumerate()
             .filter(|(_, j)| j.motor.is_some());
         self.motor_joints.extend(motors.map(|(k, _)| k as u32));
+        self.pin_plan
+            .plan(&self.joints, &self.joint_islands, &self.bodies);
     }
 
     /// The contacts' points, in the order of `grouped` (island by island), their
@@ -882,12 +889,20 @@ impl SoftStepSolver {
                 }
             }
         }
-        for j in &self.joints {
-            // A pin's impulse acts at its anchors where they are now: at the step's first
-            // arms, a tiny-inertia body far from its pin would be spun by the stale lever.
-            let ra = rotate_delta(self.bodies[j.a as usize].dq, j.r_a);
-            let rb = rotate_delta(self.bodies[j.b as usize].dq, j.r_b);
-            Self::apply(&mut self.bodies, j.a, j.b, ra, rb, j.impulse);
+        // The pins' impulses, then their motors'.
+        for &(start, end) in &self.joint_islands {
+            if !PinPlan::batches_island(end - start) {
+                for j in &self.joints[start..end] {
+                    warm_start_pin(&mut self.bodies, j);
+                }
+            }
+        }
+        self.pin_plan.warm_start(&mut self.bodies);
+        for &k in self.pin_plan.alone() {
+            warm_start_pin(&mut self.bodies, &self.joints[k as usize]);
+        }
+        for &k in &self.motor_joints {
+            let j = &self.joints[k as usize];
             let (a, b) = (j.a as usize, j.b as usize);
             let ia = self.bodies[a].inv_inertia;
             self.bodies[a].w += ia * j.motor_impulse;
@@ -912,8 +927,11 @@ impl SoftStepSolver {
         }
         for &(start, end) in &self.joint_islands {
             let island = &mut self.joints[start..end];
+            if PinPlan::batches_island(island.len()) {
+                continue;
+            }
             // A lone pin's 2 × 2 is solved in closed form below.
-            let solved = (2..=DIRECT_JOINT_LIMIT).contains(&island.len())
+            let solved = island.len() >= 2
                 && self
                     .block
                     .solve(&mut self.bodies, island, joint_soft, joint_push, use_bias);
@@ -922,6 +940,16 @@ impl SoftStepSolver {
                     solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
                 }
             }
+        }
+        let pin_pass = PinPass {
+            soft: *joint_soft,
+            max_push: joint_push,
+            use_bias,
+        };
+        self.pin_plan.solve(&mut self.bodies, &pin_pass);
+        for &k in self.pin_plan.alone() {
+            let j = &mut self.joints[k as usize];
+            solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
         }
         let pass = PassSettings {
             inv_h,
@@ -1049,6 +1077,15 @@ impl SoftStepSolver {
         }
         self.joint_memory.finish();
     }
+}
+
+/// Re-applies a pin's accumulated impulse (not its motor's) at the start of a substep,
+/// at its anchors where they are now: at the step's first arms, a tiny-inertia body far
+/// from its pin would be spun by the stale lever.
+fn warm_start_pin(bodies: &mut [SoftBody], j: &SoftJoint) {
+    let ra = rotate_delta(bodies[j.a as usize].dq, j.r_a);
+    let rb = rotate_delta(bodies[j.b as usize].dq, j.r_b);
+    SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, j.impulse);
 }
 
 /// Re-applies a point's accumulated impulses at the start of a substep.
@@ -1385,7 +1422,7 @@ fn pin_target(
     }
     let gap = (a.dp + ra - j.r_a) - (b.dp + rb - j.r_b) + j.base_gap;
     let bias = gap * soft.bias_rate;
-    let speed = bias.norm();
+    let speed = (bias.x * bias.x + bias.y * bias.y).sqrt();
     let bias = if speed > max_push {
         bias * (max_push / speed)
     } else {
@@ -1514,7 +1551,10 @@ fn solve_joint(
         return;
     }
     let rhs = target;
-    let solved = Vec2::new(k22 * rhs.x - k12 * rhs.y, k11 * rhs.y - k12 * rhs.x) / det;
+    let solved = Vec2::new(
+        (k22 * rhs.x - k12 * rhs.y) / det,
+        (k11 * rhs.y - k12 * rhs.x) / det,
+    );
     let impulse = -solved * mass_scale - j.impulse * impulse_scale;
     j.impulse += impulse;
     SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);

@@ -23,7 +23,7 @@
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
-use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 
 /// Lanes `4 FIRST..4 END` of a batch's eight, read from and written to their halves of an
 /// `F64x8` (the same size, layout and alignment). The halves outside `FIRST..END` of a
@@ -303,6 +303,14 @@ impl<const FIRST: usize, const END: usize> Mul for Avx2Lanes<FIRST, END> {
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
         Self::zip(self, rhs, |a, b| unsafe { _mm256_mul_pd(a, b) })
+    }
+}
+
+impl<const FIRST: usize, const END: usize> Div for Avx2Lanes<FIRST, END> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, rhs: Self) -> Self {
+        Self::zip(self, rhs, |a, b| unsafe { _mm256_div_pd(a, b) })
     }
 }
 

@@ -10,7 +10,7 @@
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
-use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 
 /// Eight f64 lanes in a 512-bit register; the same size and alignment as `F64x8`.
 #[derive(Debug, Clone, Copy)]
@@ -230,6 +230,14 @@ impl Mul for F64x8Avx512 {
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
         Self(unsafe { _mm512_mul_pd(self.0, rhs.0) })
+    }
+}
+
+impl Div for F64x8Avx512 {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, rhs: Self) -> Self {
+        Self(unsafe { _mm512_div_pd(self.0, rhs.0) })
     }
 }
 

@@ -697,20 +697,20 @@ impl<const N: usize> Default for ManifoldBatch<N> {
 
 /// A body's velocity, lane by lane.
 #[derive(Debug, Clone, Copy)]
-struct LaneVelocity<L> {
-    x: L,
-    y: L,
-    w: L,
+pub(super) struct LaneVelocity<L> {
+    pub x: L,
+    pub y: L,
+    pub w: L,
     /// The inverse masses read with the velocities (`BodyRow::Velocity`), which
     /// `scatter_velocities` may write back beside them.
-    inv_mass: L,
+    pub inv_mass: L,
 }
 
 impl<L: Lanes> LaneVelocity<L> {
     /// # Safety
     /// Every index must be below `bodies.len()` (`Lanes::gather`).
     #[inline(always)]
-    unsafe fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
+    pub unsafe fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
         // SAFETY: the caller's precondition.
         let [x, y, w, inv_mass] = unsafe { L::gather(bodies, index, BodyRow::Velocity) };
         Self { x, y, w, inv_mass }
@@ -719,7 +719,7 @@ impl<L: Lanes> LaneVelocity<L> {
     /// # Safety
     /// As `load`.
     #[inline(always)]
-    unsafe fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
+    pub unsafe fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
         let columns = [self.x, self.y, self.w, self.inv_mass];
         // SAFETY: the caller's precondition.
         unsafe { L::scatter_velocities(columns, bodies, index) };
@@ -1387,16 +1387,16 @@ fn approach<L: Lanes>(b: &mut LaneBounce<L>, vn: L, separation: L) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::super::{NormalBlock, PointLevers, solve_pair, solve_point, warm_start_point};
     use super::*;
     use crate::math::{Rot, Vec2, cross};
 
     /// A small deterministic generator (xorshift), uniform in [lo, hi).
-    struct Numbers(u64);
+    pub(in crate::solver::soft) struct Numbers(pub u64);
 
     impl Numbers {
-        fn next(&mut self, lo: f64, hi: f64) -> f64 {
+        pub(in crate::solver::soft) fn next(&mut self, lo: f64, hi: f64) -> f64 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 7;
             self.0 ^= self.0 << 17;
@@ -1404,7 +1404,8 @@ mod tests {
         }
     }
 
-    fn body(n: &mut Numbers, moving: bool) -> SoftBody {
+    /// A body moving (or fixed), turned and moved a little since the step's start.
+    pub(in crate::solver::soft) fn body(n: &mut Numbers, moving: bool) -> SoftBody {
         let (inv_mass, inv_inertia) = if moving {
             (n.next(0.1, 2.0), n.next(0.1, 6.0))
         } else {

@@ -6,7 +6,7 @@
 //! scalar code does, so all three give the same bits.
 
 use super::{BodyRow, SoftBody};
-use std::ops::{Add, AddAssign, BitAnd, BitXor, Mul, Neg, Sub, SubAssign};
+use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 
 /// How many manifolds a batch holds, one a lane.
 pub(super) const LANES: usize = 8;
@@ -18,6 +18,7 @@ pub(super) trait Lanes:
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
+    + Div<Output = Self>
     + Neg<Output = Self>
     + AddAssign
     + SubAssign
@@ -228,6 +229,14 @@ impl Mul for F64x8 {
     #[inline(always)]
     fn mul(self, rhs: Self) -> Self {
         self.zip(rhs, |a, b| a * b)
+    }
+}
+
+impl Div for F64x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, rhs: Self) -> Self {
+        self.zip(rhs, |a, b| a / b)
     }
 }
 
