@@ -889,11 +889,13 @@ impl SoftStepSolver {
                 }
             }
         }
-        // The pins' impulses, then their motors'.
+        // Each pin's impulse and its motor's, pin by pin; the batched islands' pins, then
+        // their motors'.
         for &(start, end) in &self.joint_islands {
             if !PinPlan::batches_island(end - start) {
                 for j in &self.joints[start..end] {
                     warm_start_pin(&mut self.bodies, j);
+                    warm_start_motor(&mut self.bodies, j);
                 }
             }
         }
@@ -901,13 +903,15 @@ impl SoftStepSolver {
         for &k in self.pin_plan.alone() {
             warm_start_pin(&mut self.bodies, &self.joints[k as usize]);
         }
-        for &k in &self.motor_joints {
-            let j = &self.joints[k as usize];
-            let (a, b) = (j.a as usize, j.b as usize);
-            let ia = self.bodies[a].inv_inertia;
-            self.bodies[a].w += ia * j.motor_impulse;
-            let ib = self.bodies[b].inv_inertia;
-            self.bodies[b].w -= ib * j.motor_impulse;
+        for &(start, end) in &self.joint_islands {
+            if PinPlan::batches_island(end - start) {
+                // `motor_joints` is in the joints' order.
+                let from = self.motor_joints.partition_point(|&k| (k as usize) < start);
+                let motors = self.motor_joints[from..].iter();
+                for &k in motors.take_while(|&&k| (k as usize) < end) {
+                    warm_start_motor(&mut self.bodies, &self.joints[k as usize]);
+                }
+            }
         }
     }
 
@@ -1077,6 +1081,15 @@ impl SoftStepSolver {
         }
         self.joint_memory.finish();
     }
+}
+
+/// Re-applies a pin's motor's accumulated angular impulse (zero without one).
+fn warm_start_motor(bodies: &mut [SoftBody], j: &SoftJoint) {
+    let (a, b) = (j.a as usize, j.b as usize);
+    let ia = bodies[a].inv_inertia;
+    bodies[a].w += ia * j.motor_impulse;
+    let ib = bodies[b].inv_inertia;
+    bodies[b].w -= ib * j.motor_impulse;
 }
 
 /// Re-applies a pin's accumulated impulse (not its motor's) at the start of a substep,
