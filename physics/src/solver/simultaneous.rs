@@ -30,7 +30,8 @@ pub enum IslandMethod {
     SoftPointByPoint,
     /// `soft`: an island of pins, solved as one linear system per pass.
     SoftPinBlock,
-    /// `soft`: pins one by one (a lone pin, or an island above the block limit).
+    /// `soft`: pins one by one (a lone pin, or an island above the block limit, whose
+    /// pins go colour by colour, eight at a time, each lane as if alone: `soft::pins`).
     SoftPinByPin,
 }
 

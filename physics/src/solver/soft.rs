@@ -42,8 +42,9 @@ pub fn lane_path_name() -> &'static str {
 }
 
 /// Joint islands up to this many pins are solved as one linear system per pass (a dense
-/// Cholesky of 2m × 2m); larger ones pin by pin. One pass of pin-by-pin Gauss–Seidel
-/// cannot hold a light chain under a heavy load: the error travels one link per pass.
+/// Cholesky of 2m × 2m); larger ones pin by pin, in coloured batches (`pins`). One pass of
+/// pin-by-pin Gauss–Seidel cannot hold a light chain under a heavy load: the error
+/// travels one link per pass.
 const DIRECT_JOINT_LIMIT: usize = 64;
 
 /// Tuning of the soft step; defaults after Box2D v3, scaled by the world's length scale.
