@@ -16,7 +16,7 @@ use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
-use batch::{LanePath, PassItem, PassPlan, PassSettings, PlanInput};
+use batch::{LaneBatch, LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 use pins::{PinPass, PinPlan};
 
 #[cfg(target_arch = "x86_64")]

@@ -844,105 +844,129 @@ impl LanePath {
     }
 }
 
-impl<const N: usize> ManifoldBatch<N> {
-    /// `warm_start` for the batch's points, with the lanes of `path`, which this processor
-    /// must run (`LanePath::best`).
-    pub(super) fn warm_start_on(&self, path: LanePath, bodies: &mut [SoftBody]) {
+/// A batch of eight lanes stored with `F64x8` (`ManifoldBatch`, `pins::PinBatch`), whose
+/// warm start and pass run with the lanes `LanePath` picks: one code, compiled for each
+/// path, reading the batch's bytes as that path's lane type.
+///
+/// # Safety
+/// `Self::With<L>` must be `Self` with `L` in place of `F64x8`: the same size, alignment
+/// and layout (`repr(C)`, lanes of one size and alignment; any bits are valid in each), so
+/// that a batch can be read as it.
+pub(super) unsafe trait LaneBatch: Sized {
+    /// What a pass reads besides the bodies.
+    type Pass;
+    /// The batch read with the lanes `L`.
+    type With<L: Lanes>: BatchLanes<Self::Pass>;
+
+    /// Whether any of lanes 4–7 is in use: the AVX2 path skips that half if not.
+    fn upper_half_used(&self) -> bool;
+
+    /// The warm start on every lane, with the lanes of `path`, which this processor must
+    /// run (`LanePath::best`).
+    fn warm_start_on(&self, path: LanePath, bodies: &mut [SoftBody]) {
         match path {
-            LanePath::Portable => self.warm_start_lanes(bodies),
+            // SAFETY: plain arrays run anywhere.
+            LanePath::Portable => unsafe { as_lanes::<Self, F64x8>(self) }.warm_start_lanes(bodies),
             // SAFETY: `path` is one this processor runs (`LanePath::best`, `available`).
             #[cfg(target_arch = "x86_64")]
-            LanePath::Avx2 => unsafe { self.warm_start_avx2(bodies) },
+            LanePath::Avx2 => unsafe { warm_start_avx2(self, bodies) },
             #[cfg(target_arch = "x86_64")]
-            LanePath::Avx512 => unsafe { self.warm_start_avx512(bodies) },
+            LanePath::Avx512 => unsafe { warm_start_avx512(self, bodies) },
         }
     }
 
-    /// `solve_pair` (or `solve_point`) on every lane, with the lanes of `path`, as
-    /// `warm_start_on`.
-    pub(super) fn solve_on(
-        &mut self,
-        path: LanePath,
-        bodies: &mut [SoftBody],
-        pass: &PassSettings,
-    ) {
+    /// A pass on every lane, with the lanes of `path`, as `warm_start_on`.
+    fn solve_on(&mut self, path: LanePath, bodies: &mut [SoftBody], pass: &Self::Pass) {
         match path {
-            LanePath::Portable => self.solve_lanes(bodies, pass),
             // SAFETY: as in `warm_start_on`.
+            LanePath::Portable => {
+                unsafe { as_lanes_mut::<Self, F64x8>(self) }.solve_lanes(bodies, pass)
+            }
             #[cfg(target_arch = "x86_64")]
-            LanePath::Avx2 => unsafe { self.solve_avx2(bodies, pass) },
+            LanePath::Avx2 => unsafe { solve_avx2(self, bodies, pass) },
             #[cfg(target_arch = "x86_64")]
-            LanePath::Avx512 => unsafe { self.solve_avx512(bodies, pass) },
+            LanePath::Avx512 => unsafe { solve_avx512(self, bodies, pass) },
         }
     }
+}
 
-    /// The batch read with the lane type `L`: the same bytes (`repr(C)`, lanes of one
-    /// size and alignment, asserted above; any bits are valid in each).
-    ///
-    /// # Safety
-    /// The processor must run `L`'s instructions.
-    #[inline(always)]
-    unsafe fn as_lanes<L: Lanes>(&self) -> &ManifoldBatch<N, L> {
-        // SAFETY: see above; the borrow is `self`'s.
-        unsafe { &*(self as *const Self).cast::<ManifoldBatch<N, L>>() }
+/// A batch's warm start and pass, in the lanes it is read with (`LaneBatch::With`).
+pub(super) trait BatchLanes<Pass> {
+    fn warm_start_lanes(&self, bodies: &mut [SoftBody]);
+    fn solve_lanes(&mut self, bodies: &mut [SoftBody], pass: &Pass);
+}
+
+/// `batch` read with the lane type `L`.
+///
+/// # Safety
+/// The processor must run `L`'s instructions.
+#[inline(always)]
+unsafe fn as_lanes<B: LaneBatch, L: Lanes>(batch: &B) -> &B::With<L> {
+    // SAFETY: the same bytes (`LaneBatch`'s contract); the borrow is `batch`'s.
+    unsafe { &*(batch as *const B).cast::<B::With<L>>() }
+}
+
+/// # Safety
+/// As `as_lanes`.
+#[inline(always)]
+unsafe fn as_lanes_mut<B: LaneBatch, L: Lanes>(batch: &mut B) -> &mut B::With<L> {
+    // SAFETY: as `as_lanes`.
+    unsafe { &mut *(batch as *mut B).cast::<B::With<L>>() }
+}
+
+/// The same code compiled for AVX2, whose 256-bit registers hold half the lanes. The warm
+/// start goes half by half (a batch's lanes share no moving body, so each half is as if
+/// alone), skipping an unused upper half; see `avx2`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn warm_start_avx2<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
+    // SAFETY (both): this function runs only where the processor has AVX2
+    // (`LaneBatch::warm_start_on`).
+    unsafe { as_lanes::<B, LowerHalf>(batch) }.warm_start_lanes(bodies);
+    if batch.upper_half_used() {
+        unsafe { as_lanes::<B, UpperHalf>(batch) }.warm_start_lanes(bodies);
     }
+}
 
-    /// # Safety
-    /// As `as_lanes`.
-    #[inline(always)]
-    unsafe fn as_lanes_mut<L: Lanes>(&mut self) -> &mut ManifoldBatch<N, L> {
-        // SAFETY: as `as_lanes`.
-        unsafe { &mut *(self as *mut Self).cast::<ManifoldBatch<N, L>>() }
+/// A pass solves both halves at once, interleaved, unless the upper one is unused.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn solve_avx2<B: LaneBatch>(batch: &mut B, bodies: &mut [SoftBody], pass: &B::Pass) {
+    // SAFETY (both): this function runs only where the processor has AVX2
+    // (`LaneBatch::solve_on`).
+    if batch.upper_half_used() {
+        unsafe { as_lanes_mut::<B, BothHalves>(batch) }.solve_lanes(bodies, pass);
+    } else {
+        unsafe { as_lanes_mut::<B, LowerHalf>(batch) }.solve_lanes(bodies, pass);
     }
+}
 
-    /// Whether any of lanes 4–7 holds a manifold: the AVX2 path skips that half if not.
-    #[cfg(target_arch = "x86_64")]
+/// The same code compiled for AVX-512, whose 512-bit registers hold all eight lanes.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn warm_start_avx512<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
+    // SAFETY: this function runs only where the processor has AVX-512F.
+    unsafe { as_lanes::<B, F64x8Avx512>(batch) }.warm_start_lanes(bodies)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn solve_avx512<B: LaneBatch>(batch: &mut B, bodies: &mut [SoftBody], pass: &B::Pass) {
+    // SAFETY: this function runs only where the processor has AVX-512F.
+    unsafe { as_lanes_mut::<B, F64x8Avx512>(batch) }.solve_lanes(bodies, pass)
+}
+
+unsafe impl<const N: usize> LaneBatch for ManifoldBatch<N> {
+    type Pass = PassSettings;
+    type With<L: Lanes> = ManifoldBatch<N, L>;
+
     #[inline(always)]
     fn upper_half_used(&self) -> bool {
         self.first_point[LANES / 2..].iter().any(|&f| f != PAD)
     }
+}
 
-    /// The same code compiled for AVX2, whose 256-bit registers hold half the lanes. The
-    /// warm start goes half by half (its manifolds share no moving body, so each half is
-    /// as if alone), skipping an unused upper half; see `avx2`.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        // SAFETY (both): this function runs only where the processor has AVX2
-        // (`warm_start_on`).
-        unsafe { self.as_lanes::<LowerHalf>() }.warm_start_lanes(bodies);
-        if self.upper_half_used() {
-            unsafe { self.as_lanes::<UpperHalf>() }.warm_start_lanes(bodies);
-        }
-    }
-
-    /// A pass solves both halves at once, interleaved, unless the upper one is unused.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        // SAFETY (both): this function runs only where the processor has AVX2 (`solve_on`).
-        if self.upper_half_used() {
-            unsafe { self.as_lanes_mut::<BothHalves>() }.solve_lanes(bodies, pass);
-        } else {
-            unsafe { self.as_lanes_mut::<LowerHalf>() }.solve_lanes(bodies, pass);
-        }
-    }
-
-    /// The same code compiled for AVX-512, whose 512-bit registers hold all eight lanes.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn warm_start_avx512(&self, bodies: &mut [SoftBody]) {
-        // SAFETY: this function runs only where the processor has AVX-512F.
-        unsafe { self.as_lanes::<F64x8Avx512>() }.warm_start_lanes(bodies)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn solve_avx512(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        // SAFETY: this function runs only where the processor has AVX-512F.
-        unsafe { self.as_lanes_mut::<F64x8Avx512>() }.solve_lanes(bodies, pass)
-    }
-
+impl<const N: usize> ManifoldBatch<N> {
     /// Fills the batch with the manifolds whose first points are `first_point` (`PAD`:
     /// an unused lane, on the null body, the last of `bodies`).
     fn fill(&mut self, first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
@@ -1095,26 +1119,6 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         }
     }
 
-    /// `warm_start` for the batch's points.
-    #[inline(always)]
-    fn warm_start_lanes(&self, bodies: &mut [SoftBody]) {
-        assert!(
-            self.indices_fit(bodies),
-            "a batch's bodies are the solver's"
-        );
-        // SAFETY: just checked.
-        let mut pair = unsafe { self.load(bodies) };
-        let normal = (self.normal_x, self.normal_y);
-        let tangent = (-self.normal_y, self.normal_x);
-        for (p, &impulse) in self.points.iter().zip(&self.normal_impulses) {
-            pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, impulse);
-            // The tangent row's levers are the reaches (`PointLevers::tangent`).
-            pair.apply_along(tangent, p.reach_a, p.reach_b, p.tangent_impulse);
-        }
-        // SAFETY: checked above.
-        unsafe { self.store(&pair, bodies) };
-    }
-
     /// `separation` for each lane's point `which`.
     ///
     /// # Safety
@@ -1138,62 +1142,6 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             *s = separation(p);
         }
         separations
-    }
-
-    /// `solve_pair` on every lane.
-    #[inline(always)]
-    fn solve_lanes(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
-        assert!(
-            self.indices_fit(bodies),
-            "a batch's bodies are the solver's"
-        );
-        // SAFETY: just checked.
-        let (separations, mut pair) = unsafe { (self.separations(bodies), self.load(bodies)) };
-        let normal = (self.normal_x, self.normal_y);
-        let zero = L::splat(0.0);
-        let one = L::splat(1.0);
-        // `normal_target`: speculative points close their gap, touching ones are soft
-        // with bias (or rigid in the relax pass).
-        let target = |s: L| {
-            let speculative = s.gt(zero);
-            let (target, mass_scale, impulse_scale) = if pass.use_bias {
-                let bias = -(L::splat(pass.soft.bias_rate) * s).max(L::splat(-pass.max_push));
-                (
-                    bias,
-                    L::splat(pass.soft.mass_scale),
-                    L::splat(pass.soft.impulse_scale),
-                )
-            } else {
-                (zero, one, zero)
-            };
-            (
-                speculative.select(-s * L::splat(pass.inv_h), target),
-                speculative.select(one, mass_scale),
-                speculative.select(zero, impulse_scale),
-            )
-        };
-        let mut targets = [(zero, zero, zero); N];
-        for (t, &s) in targets.iter_mut().zip(&separations) {
-            *t = target(s);
-        }
-        if N == 2 {
-            self.solve_normals_together(&mut pair, &separations, &targets, pass);
-        } else {
-            let bounce = self.may_bounce().then_some(&mut self.bounce[..]);
-            let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
-            solve_normals_alone(&mut pair, points, normal, &separations, &targets);
-        }
-        let tangent = (-self.normal_y, self.normal_x);
-        for (p, &normal_impulse) in self.points.iter_mut().zip(&self.normal_impulses) {
-            let vt = pair.velocity_along(tangent, p.reach_a, p.reach_b);
-            let limit = self.friction * normal_impulse;
-            let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
-            let delta = total - p.tangent_impulse;
-            p.tangent_impulse.set(total);
-            pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
-        }
-        // SAFETY: checked above.
-        unsafe { self.store(&pair, bodies) };
     }
 
     /// A two-point manifold's normals, as `solve_pair` solves them: together, except in
@@ -1285,6 +1233,84 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
                 total,
             );
         }
+    }
+}
+
+impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> {
+    /// `warm_start` for the batch's points.
+    #[inline(always)]
+    fn warm_start_lanes(&self, bodies: &mut [SoftBody]) {
+        assert!(
+            self.indices_fit(bodies),
+            "a batch's bodies are the solver's"
+        );
+        // SAFETY: just checked.
+        let mut pair = unsafe { self.load(bodies) };
+        let normal = (self.normal_x, self.normal_y);
+        let tangent = (-self.normal_y, self.normal_x);
+        for (p, &impulse) in self.points.iter().zip(&self.normal_impulses) {
+            pair.apply_along(normal, p.normal_lever_a, p.normal_lever_b, impulse);
+            // The tangent row's levers are the reaches (`PointLevers::tangent`).
+            pair.apply_along(tangent, p.reach_a, p.reach_b, p.tangent_impulse);
+        }
+        // SAFETY: checked above.
+        unsafe { self.store(&pair, bodies) };
+    }
+
+    /// `solve_pair` on every lane.
+    #[inline(always)]
+    fn solve_lanes(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
+        assert!(
+            self.indices_fit(bodies),
+            "a batch's bodies are the solver's"
+        );
+        // SAFETY: just checked.
+        let (separations, mut pair) = unsafe { (self.separations(bodies), self.load(bodies)) };
+        let normal = (self.normal_x, self.normal_y);
+        let zero = L::splat(0.0);
+        let one = L::splat(1.0);
+        // `normal_target`: speculative points close their gap, touching ones are soft
+        // with bias (or rigid in the relax pass).
+        let target = |s: L| {
+            let speculative = s.gt(zero);
+            let (target, mass_scale, impulse_scale) = if pass.use_bias {
+                let bias = -(L::splat(pass.soft.bias_rate) * s).max(L::splat(-pass.max_push));
+                (
+                    bias,
+                    L::splat(pass.soft.mass_scale),
+                    L::splat(pass.soft.impulse_scale),
+                )
+            } else {
+                (zero, one, zero)
+            };
+            (
+                speculative.select(-s * L::splat(pass.inv_h), target),
+                speculative.select(one, mass_scale),
+                speculative.select(zero, impulse_scale),
+            )
+        };
+        let mut targets = [(zero, zero, zero); N];
+        for (t, &s) in targets.iter_mut().zip(&separations) {
+            *t = target(s);
+        }
+        if N == 2 {
+            self.solve_normals_together(&mut pair, &separations, &targets, pass);
+        } else {
+            let bounce = self.may_bounce().then_some(&mut self.bounce[..]);
+            let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
+            solve_normals_alone(&mut pair, points, normal, &separations, &targets);
+        }
+        let tangent = (-self.normal_y, self.normal_x);
+        for (p, &normal_impulse) in self.points.iter_mut().zip(&self.normal_impulses) {
+            let vt = pair.velocity_along(tangent, p.reach_a, p.reach_b);
+            let limit = self.friction * normal_impulse;
+            let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
+            let delta = total - p.tangent_impulse;
+            p.tangent_impulse.set(total);
+            pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
+        }
+        // SAFETY: checked above.
+        unsafe { self.store(&pair, bodies) };
     }
 }
 

@@ -9,14 +9,11 @@
 //! last one's velocities were stored. In batches the 100 × 100 net's passes take half the
 //! time (docs/bench/profile.md, "Pins in batches").
 
-use super::batch::{LanePath, LaneVelocity, PAD};
+use super::batch::{BatchLanes, LaneBatch, LanePath, LaneVelocity, PAD};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, DIRECT_JOINT_LIMIT, SoftBody, SoftJoint, Softness};
 #[cfg(target_arch = "x86_64")]
-use super::{
-    avx2::{BothHalves, LowerHalf, UpperHalf},
-    avx512::F64x8Avx512,
-};
+use super::{avx2::UpperHalf, avx512::F64x8Avx512};
 use crate::math::Vec2;
 use crate::solver::island::counting_sort;
 
@@ -263,96 +260,15 @@ impl PinBatch {
             }
         }
     }
+}
 
-    /// `warm_start_pin` on every lane, with the lanes of `path`, which this processor
-    /// must run (`LanePath::best`).
-    fn warm_start_on(&self, path: LanePath, bodies: &mut [SoftBody]) {
-        match path {
-            LanePath::Portable => self.warm_start_lanes(bodies),
-            // SAFETY: `path` is one this processor runs (`LanePath::best`, `available`).
-            #[cfg(target_arch = "x86_64")]
-            LanePath::Avx2 => unsafe { self.warm_start_avx2(bodies) },
-            #[cfg(target_arch = "x86_64")]
-            LanePath::Avx512 => unsafe { self.warm_start_avx512(bodies) },
-        }
-    }
+unsafe impl LaneBatch for PinBatch {
+    type Pass = PinPass;
+    type With<L: Lanes> = PinBatch<L>;
 
-    /// `solve_joint` on every lane, with the lanes of `path`, as `warm_start_on`.
-    fn solve_on(&mut self, path: LanePath, bodies: &mut [SoftBody], pass: &PinPass) {
-        match path {
-            LanePath::Portable => self.solve_lanes(bodies, pass),
-            // SAFETY: as in `warm_start_on`.
-            #[cfg(target_arch = "x86_64")]
-            LanePath::Avx2 => unsafe { self.solve_avx2(bodies, pass) },
-            #[cfg(target_arch = "x86_64")]
-            LanePath::Avx512 => unsafe { self.solve_avx512(bodies, pass) },
-        }
-    }
-
-    /// The batch read with the lane type `L`: the same bytes (`repr(C)`, lanes of one
-    /// size and alignment, asserted above; any bits are valid in each).
-    ///
-    /// # Safety
-    /// The processor must run `L`'s instructions.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn as_lanes<L: Lanes>(&self) -> &PinBatch<L> {
-        // SAFETY: see above; the borrow is `self`'s.
-        unsafe { &*(self as *const Self).cast::<PinBatch<L>>() }
-    }
-
-    /// # Safety
-    /// As `as_lanes`.
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    unsafe fn as_lanes_mut<L: Lanes>(&mut self) -> &mut PinBatch<L> {
-        // SAFETY: as `as_lanes`.
-        unsafe { &mut *(self as *mut Self).cast::<PinBatch<L>>() }
-    }
-
-    /// Whether any of lanes 4–7 holds a pin: the AVX2 path skips that half if not.
-    #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn upper_half_used(&self) -> bool {
         self.pin[LANES / 2..].iter().any(|&p| p != PAD)
-    }
-
-    /// Half by half, as `ManifoldBatch::warm_start_avx2`.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn warm_start_avx2(&self, bodies: &mut [SoftBody]) {
-        // SAFETY (both): this function runs only where the processor has AVX2
-        // (`warm_start_on`).
-        unsafe { self.as_lanes::<LowerHalf>() }.warm_start_lanes(bodies);
-        if self.upper_half_used() {
-            unsafe { self.as_lanes::<UpperHalf>() }.warm_start_lanes(bodies);
-        }
-    }
-
-    /// Both halves at once, as `ManifoldBatch::solve_avx2`.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn solve_avx2(&mut self, bodies: &mut [SoftBody], pass: &PinPass) {
-        // SAFETY (both): this function runs only where the processor has AVX2 (`solve_on`).
-        if self.upper_half_used() {
-            unsafe { self.as_lanes_mut::<BothHalves>() }.solve_lanes(bodies, pass);
-        } else {
-            unsafe { self.as_lanes_mut::<LowerHalf>() }.solve_lanes(bodies, pass);
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn warm_start_avx512(&self, bodies: &mut [SoftBody]) {
-        // SAFETY: this function runs only where the processor has AVX-512F.
-        unsafe { self.as_lanes::<F64x8Avx512>() }.warm_start_lanes(bodies)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
-    fn solve_avx512(&mut self, bodies: &mut [SoftBody], pass: &PinPass) {
-        // SAFETY: this function runs only where the processor has AVX-512F.
-        unsafe { self.as_lanes_mut::<F64x8Avx512>() }.solve_lanes(bodies, pass)
     }
 }
 
@@ -444,7 +360,9 @@ impl<L: Lanes> PinBatch<L> {
             b.store(bodies, &self.b);
         }
     }
+}
 
+impl<L: Lanes> BatchLanes<PinPass> for PinBatch<L> {
     /// `warm_start_pin` on every lane.
     #[inline(always)]
     fn warm_start_lanes(&self, bodies: &mut [SoftBody]) {
