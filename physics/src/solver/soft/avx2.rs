@@ -54,7 +54,7 @@ const _: () = {
 const HALF: usize = LANES / 2;
 
 // SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions these
-// types are used in are compiled for and only called with (`ManifoldBatch::as_lanes`); the
+// types are used in are compiled for and only called with (`batch::LaneBatch`); the
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
 // inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`, and
 // the bodies lie inside the slice (`Lanes::gather`'s precondition).

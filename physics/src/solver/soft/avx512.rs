@@ -28,7 +28,7 @@ const _: () = {
 };
 
 // SAFETY (every `unsafe` block below): the intrinsics need AVX-512F, which the functions
-// this type is used in are compiled for and only called with (`ManifoldBatch::as_lanes`);
+// this type is used in are compiled for and only called with (`batch::LaneBatch`);
 // the aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name,
 // which lie inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned
 // `SoftBody`, and the bodies lie inside the slice (`Lanes::gather`'s precondition).
