@@ -956,6 +956,8 @@ fn solve_avx512<B: LaneBatch>(batch: &mut B, bodies: &mut [SoftBody], pass: &B::
     unsafe { as_lanes_mut::<B, F64x8Avx512>(batch) }.solve_lanes(bodies, pass)
 }
 
+// SAFETY: `ManifoldBatch<N, L>` is `repr(C)` with lanes of `F64x8`'s size and alignment
+// (asserted with the struct), any bits valid in each.
 unsafe impl<const N: usize> LaneBatch for ManifoldBatch<N> {
     type Pass = PassSettings;
     type With<L: Lanes> = ManifoldBatch<N, L>;

@@ -262,6 +262,8 @@ impl PinBatch {
     }
 }
 
+// SAFETY: `PinBatch<L>` is `repr(C)` with lanes of `F64x8`'s size and alignment
+// (asserted above), any bits valid in each.
 unsafe impl LaneBatch for PinBatch {
     type Pass = PinPass;
     type With<L: Lanes> = PinBatch<L>;
@@ -273,7 +275,7 @@ unsafe impl LaneBatch for PinBatch {
 }
 
 /// A body's velocity change from `impulse` at the arm `r` (`BodyPair::apply`, one side):
-/// `sign` +1 on A, −1 on B, as the scalar `+=` and `-=`.
+/// added on A (`on_a`), taken off B, as the scalar `+=` and `-=`.
 #[inline(always)]
 fn push<L: Lanes>(
     body: &mut LaneVelocity<L>,
