@@ -93,9 +93,17 @@ pub struct IslandGrouping {
     ends: Vec<(u32, u32)>,
     dynamic: Vec<bool>,
     grouped: Vec<(u32, u32)>,
+    /// Whether the last call kept the grouping before it.
+    kept: bool,
 }
 
 impl IslandGrouping {
+    /// Whether the last `group` found the same items and bodies as the call before it, and
+    /// so returned the grouping it had: what a caller planned from that grouping stands.
+    pub fn kept(&self) -> bool {
+        self.kept
+    }
+
     /// `group_by_island`'s result for these items, found again only if an item's ends or
     /// a body's `dynamic` differ from the last call's.
     pub fn group(
@@ -110,6 +118,7 @@ impl IslandGrouping {
             && (0..count).all(|i| self.ends[i] == ends(i))
             && self.dynamic.len() == bodies
             && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32));
+        self.kept = same;
         if !same {
             self.dynamic.clear();
             self.dynamic.extend((0..bodies as u32).map(&dynamic));
@@ -175,15 +184,17 @@ mod tests {
     #[test]
     fn a_kept_grouping_follows_every_change() {
         let mut kept = IslandGrouping::default();
-        let cases: [(&[(u32, u32)], u32); 6] = [
-            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4),
-            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4),
-            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 1), // body 1 now fixed: 0 and 4 part
-            (&[(0, 1), (1, 4), (2, 4), (3, 2)], 1),
-            (&[(0, 1), (1, 4), (2, 4)], 1),
-            (&[(0, 1), (1, 4), (2, 4), (2, 3), (3, 0)], 4),
+        // Items, the fixed body, and whether the grouping is the last call's.
+        type Case<'a> = (&'a [(u32, u32)], u32, bool);
+        let cases: [Case; 6] = [
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4, false),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 4, true),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3)], 1, false), // body 1 now fixed: 0 and 4 part
+            (&[(0, 1), (1, 4), (2, 4), (3, 2)], 1, false),
+            (&[(0, 1), (1, 4), (2, 4)], 1, false),
+            (&[(0, 1), (1, 4), (2, 4), (2, 3), (3, 0)], 4, false),
         ];
-        for (items, fixed) in cases {
+        for (items, fixed, same) in cases {
             let mut uf = UnionFind::default();
             let mut fresh = vec![];
             group_by_island(
@@ -196,6 +207,7 @@ mod tests {
             );
             let got = kept.group(items.len(), 5, |i| items[i], |s| s != fixed);
             assert_eq!(got, &fresh[..], "{items:?}, body {fixed} fixed");
+            assert_eq!(kept.kept(), same, "{items:?}, body {fixed} fixed");
         }
     }
 

@@ -630,8 +630,9 @@ impl SoftStepSolver {
             .enumerate()
             .filter(|(_, j)| j.motor.is_some());
         self.motor_joints.extend(motors.map(|(k, _)| k as u32));
+        let unchanged = self.joint_grouping.kept();
         self.pin_plan
-            .plan(&self.joints, &self.joint_islands, &self.bodies);
+            .plan(&self.joints, &self.joint_islands, &self.bodies, unchanged);
     }
 
     /// The contacts' points, in the order of `grouped` (island by island), their

@@ -42,10 +42,6 @@ pub(super) struct PinPlan {
     coloured: Vec<(u32, u32)>,
     by_colour: Vec<(u32, u32)>,
     starts: Vec<u32>,
-    /// Every pin's bodies, and whether each moves, when the batches were planned: the
-    /// islands and colours follow from them, and while they stay, `plan` only fills the
-    /// batches again.
-    planned_for: Vec<(u32, u32, bool, bool)>,
 }
 
 impl PinPlan {
@@ -57,26 +53,23 @@ impl PinPlan {
 
     /// Colours the pins of every island that `batches_island` and fills their batches,
     /// colour by colour (each colour's pins in the island's order); `bodies` ends with the
-    /// null body, where unused lanes point.
-    pub fn plan(&mut self, joints: &[SoftJoint], islands: &[(usize, usize)], bodies: &[SoftBody]) {
+    /// null body, where unused lanes point. `unchanged`: the joints join the same bodies,
+    /// each moving or not, as at the last call (`IslandGrouping::kept`), so the colours
+    /// stand and only the batches' numbers are filled again.
+    pub fn plan(
+        &mut self,
+        joints: &[SoftJoint],
+        islands: &[(usize, usize)],
+        bodies: &[SoftBody],
+        unchanged: bool,
+    ) {
         let null_body = bodies.len() as u32 - 1;
-        let ends = |j: &SoftJoint| {
-            let moves = |i: u32| bodies[i as usize].moves();
-            (j.a, j.b, moves(j.a), moves(j.b))
-        };
-        if self.planned_for.len() == joints.len()
-            && joints
-                .iter()
-                .zip(&self.planned_for)
-                .all(|(j, &e)| ends(j) == e)
-        {
+        if unchanged {
             for batch in &mut self.batches[..self.filled] {
                 batch.fill(batch.pin, joints, bodies, null_body);
             }
             return;
         }
-        self.planned_for.clear();
-        self.planned_for.extend(joints.iter().map(ends));
         self.filled = 0;
         self.alone.clear();
         let mut batched = islands
@@ -181,7 +174,7 @@ pub(super) struct PinPass {
 
 /// Eight pins with no moving body in common, lane by lane. Stored with `F64x8` lanes;
 /// `repr(C)`, so that the AVX2 and AVX-512 paths read the same bytes as `PinBatch<L>`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C)]
 pub(super) struct PinBatch<L = F64x8> {
     /// Each lane's pin, its index among the step's joints (`PAD`: an unused lane, on the
@@ -208,23 +201,6 @@ const _: () = {
     assert!(size_of::<PinBatch>() == size_of::<PinBatch<F64x8Avx512>>());
     assert!(align_of::<PinBatch>() == align_of::<PinBatch<F64x8Avx512>>());
 };
-
-impl Default for PinBatch {
-    fn default() -> Self {
-        let zero = F64x8::default();
-        Self {
-            pin: [PAD; LANES],
-            a: [0; LANES],
-            b: [0; LANES],
-            inv_inertia_a: zero,
-            inv_inertia_b: zero,
-            arm_a: [zero; 2],
-            arm_b: [zero; 2],
-            base_gap: [zero; 2],
-            impulse: [zero; 2],
-        }
-    }
-}
 
 impl PinBatch {
     /// The pins `pins` (indices into `joints`; `PAD`: an unused lane, on `null_body`).
@@ -650,8 +626,9 @@ mod tests {
         (bodies, joints)
     }
 
+    /// `plan` over one island of all the joints, made afresh.
     fn planned(joints: &[SoftJoint], bodies: &[SoftBody], plan: &mut PinPlan) {
-        plan.plan(joints, &[(0, joints.len())], bodies);
+        plan.plan(joints, &[(0, joints.len())], bodies, false);
     }
 
     /// Every pin is batched once or solved alone, and no two pins of a batch share a
@@ -691,34 +668,25 @@ mod tests {
     }
 
     /// A plan kept from the last step (the same pins between the same bodies) fills its
-    /// batches with this step's numbers, as a fresh one; one whose body stopped moving is
-    /// made again.
+    /// batches with this step's numbers, as a fresh one. (Whether they are the same is
+    /// `IslandGrouping::kept`'s to tell: `a_kept_grouping_follows_every_change`.)
     #[test]
     fn a_kept_plan_is_the_fresh_plan() {
-        let (mut bodies, mut joints) = net(12);
+        let (bodies, mut joints) = net(12);
         let mut kept = PinPlan::default();
         planned(&joints, &bodies, &mut kept);
-        let fresh = |joints: &[SoftJoint], bodies: &[SoftBody]| {
-            let mut plan = PinPlan::default();
-            planned(joints, bodies, &mut plan);
-            plan
-        };
         let batches = |plan: &PinPlan| plan.batches[..plan.filled].to_vec();
+        let before = batches(&kept);
         for j in &mut joints {
             j.impulse.y += 1.0;
             j.r_a.x += 0.25;
             j.base_gap.x -= 0.5;
         }
-        planned(&joints, &bodies, &mut kept);
-        let now = fresh(&joints, &bodies);
-        assert_eq!(batches(&kept), batches(&now));
-        assert_eq!(kept.alone(), now.alone());
-        // Body 13 fixed: its pins no longer claim its colours.
-        bodies[13].inv_mass = 0.0;
-        bodies[13].inv_inertia = 0.0;
-        planned(&joints, &bodies, &mut kept);
-        let now = fresh(&joints, &bodies);
-        assert_eq!(batches(&kept), batches(&now));
-        assert_ne!(batches(&kept), batches(&fresh(&joints, &net(12).0)));
+        kept.plan(&joints, &[(0, joints.len())], &bodies, true);
+        let mut fresh = PinPlan::default();
+        planned(&joints, &bodies, &mut fresh);
+        assert_eq!(batches(&kept), batches(&fresh));
+        assert_eq!(kept.alone(), fresh.alone());
+        assert_ne!(batches(&kept), before, "the numbers were filled again");
     }
 }
