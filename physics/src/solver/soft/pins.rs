@@ -440,6 +440,29 @@ mod tests {
     use super::super::{solve_joint, warm_start_pin};
     use super::*;
 
+    /// The step's pin `k` between `a` and `b`, without a motor.
+    fn pin(
+        k: usize,
+        (a, b): (u32, u32),
+        (r_a, r_b): (Vec2, Vec2),
+        base_gap: Vec2,
+        impulse: Vec2,
+    ) -> SoftJoint {
+        SoftJoint {
+            a,
+            b,
+            r_a,
+            r_b,
+            base_gap,
+            impulse,
+            motor_impulse: 0.0,
+            motor_step_total: 0.0,
+            motor: None,
+            slot: k as u32,
+            input: k as u32,
+        }
+    }
+
     /// Eight pins: lanes 0–5 between moving bodies, lanes 6 and 7 each on the same fixed
     /// body (which lanes may share), in both halves of the AVX2 path.
     fn eight_pins(seed: u64) -> (Vec<SoftBody>, Vec<SoftJoint>) {
@@ -461,19 +484,11 @@ mod tests {
         let joints = pairs
             .iter()
             .enumerate()
-            .map(|(k, &(a, b))| SoftJoint {
-                a,
-                b,
-                r_a: arm(),
-                r_b: arm(),
+            .map(|(k, &ends)| {
+                let arms = (arm(), arm());
                 // Some far open (their pull is capped at the pass's `max_push`).
-                base_gap: arm() * if k % 3 == 0 { 10.0 } else { 0.01 },
-                impulse: arm(),
-                motor_impulse: 0.0,
-                motor_step_total: 0.0,
-                motor: None,
-                slot: k as u32,
-                input: k as u32,
+                let gap = arm() * if k % 3 == 0 { 10.0 } else { 0.01 };
+                pin(k, ends, arms, gap, arm())
             })
             .collect();
         (bodies, joints)
@@ -609,18 +624,10 @@ mod tests {
         let joints = ends
             .iter()
             .enumerate()
-            .map(|(k, &(a, b))| SoftJoint {
-                a: a as u32,
-                b: b as u32,
-                r_a: Vec2::new(0.5, 0.0),
-                r_b: Vec2::new(-0.5, 0.0),
-                base_gap: Vec2::zeros(),
-                impulse: Vec2::new(k as f64, 0.0),
-                motor_impulse: 0.0,
-                motor_step_total: 0.0,
-                motor: None,
-                slot: k as u32,
-                input: k as u32,
+            .map(|(k, &(a, b))| {
+                let arms = (Vec2::new(0.5, 0.0), Vec2::new(-0.5, 0.0));
+                let impulse = Vec2::new(k as f64, 0.0);
+                pin(k, (a as u32, b as u32), arms, Vec2::zeros(), impulse)
             })
             .collect();
         (bodies, joints)
