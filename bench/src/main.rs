@@ -203,9 +203,10 @@ fn main() {
     write_doc(docs, "results.md", &report);
 }
 
-/// `pe <scene> [solver] [fresh] [forwards] [steps=N] [stages [from=K]]`: one pile, grid or
-/// smash scene in pe alone, so that a profiler sees only pe's step (`fresh`: no manifold
-/// reuse; `forwards`: the soft step sweeps its colours in one order only; `steps=N`:
+/// `pe <scene> [solver] [fresh] [forwards] [substeps=S] [steps=N] [stages [from=K]]`: one
+/// pile, grid or smash scene in pe alone, so that a profiler sees only pe's step (`fresh`:
+/// no manifold reuse; `forwards`: the soft step sweeps its colours in one order only;
+/// `substeps=S`: the soft step's substeps instead of the default 4; `steps=N`:
 /// exactly N steps, with no time budget, so that two builds' instruction counts compare;
 /// `stages`, in a build with the feature `stages`: the fewest and the median cycles of each
 /// stage of the step, over the steps from the K-th, by default from half way).
@@ -227,6 +228,13 @@ fn run_pe_alone() {
         reuse_manifolds: !flags.iter().any(|f| f == "fresh"),
         soft_alternating_sweeps: !flags.iter().any(|f| f == "forwards"),
         ..PeConfig::new(solver)
+    };
+    let config = PeConfig {
+        soft_substeps: flags
+            .iter()
+            .find_map(|f| f.strip_prefix("substeps=")?.parse().ok())
+            .unwrap_or(config.soft_substeps),
+        ..config
     };
     let outcome = if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
         pe_scenes::pyramid(config, spec, H)
