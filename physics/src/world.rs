@@ -176,8 +176,8 @@ const SPLIT_IMPULSE_RATE: f64 = 0.4;
 /// At most this many substeps per step (see `World::substeps_for`).
 const MAX_SUBSTEPS: usize = 8;
 
-/// While every step pairs the bodies again, every this many pairings use grown bounds, to
-/// see whether they hold again (`find_candidate_pairs`).
+/// While the broad phase pairs the bodies again every time, every this many pairings use
+/// grown bounds, to see whether they hold again (`find_candidate_pairs`).
 const RETRY_GROWN_BOUNDS: u32 = 8;
 
 /// A 2D world of rigid convex bodies.
@@ -246,13 +246,16 @@ struct Scratch {
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
     /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin` (or bare,
-    /// while grown ones do not hold), and which bodies were fixed then (see
+    /// while grown ones do not hold), and which bodies were static or asleep then (see
     /// `find_candidate_pairs`; emptied when they no longer stand).
     fat_boxes: Vec<Option<Aabb>>,
     fat_pairs: Vec<(u32, u32)>,
     fat_fixed: Vec<bool>,
-    /// How many steps in a row have paired the bodies again (0: the last step kept them).
+    /// How many times in a row the broad phase has paired the bodies again (0: it kept its
+    /// pairs the last time).
     paired_in_a_row: u32,
+    /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
+    fixed_now: Vec<bool>,
     solver_bodies: Vec<SolverBody>,
     /// How far each body can move this step, and the two parts of it: its centroid's
     /// displacement at its current velocity, and how far its spin can carry its
@@ -1430,7 +1433,14 @@ impl World {
         }
         let bodies = &self.bodies;
         // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
-        let is_fixed = |i: usize| bodies[i].as_ref().is_none_or(Body::is_fixed);
+        // The broad phase leaves out such pairs only, not those of bodies held for one pass
+        // of `auto` (whose two passes hold different bodies); those are dropped from its
+        // pairs below, so that its pairs serve both passes.
+        let is_fixed = |i: usize| {
+            bodies[i]
+                .as_ref()
+                .is_none_or(|b| b.is_static() || b.is_asleep())
+        };
         // The grown bounds' pairs still hold every pair whose bounds overlap now if every
         // body's bounds lie inside its grown ones, and the same bodies are fixed.
         let still_inside = s.fat_boxes.len() == s.boxes.len()
@@ -1481,7 +1491,21 @@ impl World {
             _ => false,
         };
         s.pairs.clear();
-        s.pairs.extend(s.fat_pairs.iter().copied().filter(overlap));
+        if s.held.is_empty() {
+            s.pairs.extend(s.fat_pairs.iter().copied().filter(overlap));
+        } else {
+            s.fixed_now.clear();
+            s.fixed_now
+                .extend(bodies.iter().map(|b| b.as_ref().is_none_or(Body::is_fixed)));
+            let fixed_now = &s.fixed_now;
+            let one_moves = |&(i, j): &(u32, u32)| !(fixed_now[i as usize] & fixed_now[j as usize]);
+            s.pairs.extend(
+                s.fat_pairs
+                    .iter()
+                    .copied()
+                    .filter(|p| one_moves(p) && overlap(p)),
+            );
+        }
     }
 
     /// Broad phase, then SAT on each candidate pair (SPEC §3.1), or the pair's last
@@ -1909,6 +1933,55 @@ mod tests {
             })
             .map(|(i, j)| (i as u32, j as u32))
             .collect()
+    }
+
+    /// `auto` holds the big islands' bodies for its exact pass and the small ones' for its
+    /// soft pass: the broad phase keeps its pairs across the holds, and each pass's
+    /// candidates are exactly the overlapping pairs of which a body moves in that pass.
+    #[test]
+    fn candidates_leave_out_the_pairs_held_still_in_each_pass_of_auto() {
+        let mut world = World::new(Vec2::new(0.0, 10.0));
+        world.settings.contact_solver = ContactSolver::Auto;
+        let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
+        world
+            .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        // A 10-row pyramid (a big island) and, apart, two stacks of two (small ones).
+        for row in 0..10 {
+            for i in 0..10 - row {
+                let at = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
+                world
+                    .add_body(BodyDef::new(unit.clone(), 1.0).at(at, 0.0))
+                    .unwrap();
+            }
+        }
+        for x in [20.0, 25.0] {
+            for y in [-0.5, -1.5] {
+                let def = BodyDef::new(unit.clone(), 1.0).at(Vec2::new(x, y), 0.1);
+                world.add_body(def).unwrap();
+            }
+        }
+        let dt = 1.0 / 60.0;
+        for _ in 0..5 {
+            world.step(dt);
+        }
+        assert_eq!(world.mark_big_islands(dt), (true, true));
+        let unheld = world.scratch.pairs.clone();
+        assert_eq!(unheld, overlapping_pairs(&world));
+        let mut moving_in_pass = vec![];
+        for big in [true, false] {
+            let fat_boxes = world.scratch.fat_boxes.clone();
+            world.hold_where(big);
+            world.find_candidate_pairs(dt);
+            assert_eq!(world.scratch.fat_boxes, fat_boxes, "pairs kept");
+            assert_eq!(world.scratch.pairs, overlapping_pairs(&world));
+            assert!(world.scratch.pairs.len() < unheld.len());
+            moving_in_pass.push(world.scratch.pairs.len());
+            world.release_held();
+        }
+        // Each pass has pairs of its own: the pyramid's, and the stacks' and floor's.
+        assert!(moving_in_pass.iter().all(|&n| n > 2), "{moving_in_pass:?}");
     }
 
     /// Debris flying apart leaves its grown bounds every step, so the broad phase pairs
