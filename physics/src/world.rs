@@ -294,6 +294,9 @@ struct Scratch {
     auto_links: Vec<(u32, u32, usize)>,
     island_rows: Vec<usize>,
     in_big_island: Vec<bool>,
+    last_marking: LastMarking,
+    #[cfg(test)]
+    marks_kept: usize,
     held: Vec<(u32, (Vec2, f64))>,
     exact_contacts: Vec<Contact>,
     exact_manifolds: Vec<Manifold>,
@@ -301,6 +304,18 @@ struct Scratch {
     /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
     /// the next contact detection at the same step length: set by `auto` only.
     candidates_current: bool,
+}
+
+/// What `auto`'s last marking of big islands was made from, and what it found: a pile at
+/// rest gives the same step after step (`World::mark_big_islands`).
+#[derive(Debug, Clone, Default)]
+struct LastMarking {
+    links: Vec<(u32, u32, usize)>,
+    candidates: Vec<(u32, u32)>,
+    fixed: Vec<bool>,
+    row_limit: usize,
+    /// `(small, big)`: whether some moving body is in a small island, some in a big one.
+    found: Option<(bool, bool)>,
 }
 
 /// How far two bodies can close on each other in a step, from each one's `motion`: their
@@ -1186,6 +1201,22 @@ impl World {
             let b = j.body_b.map_or(j.body_a.0, |h| h.0);
             links.push((j.body_a.0, b, rows));
         }
+        // The marking is a function of its links, candidates, fixed bodies and limit alone
+        // (the fixed ones are `fat_fixed`: no body is held between passes): the same
+        // inputs, the same marks, without the union-find.
+        let limit = self.settings.dense_row_limit;
+        let last = &s.last_marking;
+        if let Some(marked) = last.found
+            && (&last.links, &last.candidates, &last.fixed, last.row_limit)
+                == (&links, &s.pairs, &s.fat_fixed, limit)
+        {
+            s.auto_links = links;
+            #[cfg(test)]
+            {
+                s.marks_kept += 1;
+            }
+            return marked;
+        }
         s.island_union.reset(n);
         let candidates = s.pairs.iter().map(|&(a, b)| (a, b, 0));
         for (a, b, _) in links.iter().copied().chain(candidates) {
@@ -1223,6 +1254,12 @@ impl World {
             big |= is_big;
             small |= moving(i) && !is_big;
         }
+        let last = &mut s.last_marking;
+        last.links.clone_from(&s.auto_links);
+        last.candidates.clone_from(&s.pairs);
+        last.fixed.clone_from(&s.fat_fixed);
+        last.row_limit = limit;
+        last.found = Some((small, big));
         (small, big)
     }
 
@@ -1982,6 +2019,66 @@ mod tests {
         }
         // Each pass has pairs of its own: the pyramid's, and the stacks' and floor's.
         assert!(moving_in_pass.iter().all(|&n| n > 2), "{moving_in_pass:?}");
+    }
+
+    /// `auto` marks the big islands again only when what the marks are made from changes:
+    /// at every step, the kept marks are the ones a fresh marking gives, through a row
+    /// limit that makes the pyramid small and back, a limit that the arm's island passes
+    /// as its motor is switched off and on, and the pyramid falling asleep.
+    #[test]
+    fn big_islands_are_marked_again_whenever_what_they_are_made_from_changes() {
+        let mut world = World::new(Vec2::new(0.0, 10.0));
+        world.settings.contact_solver = ContactSolver::Auto;
+        world.settings.sleeping = true;
+        let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
+        world
+            .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for row in 0..10 {
+            for i in 0..10 - row {
+                let at = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
+                world
+                    .add_body(BodyDef::new(unit.clone(), 1.0).at(at, 0.0))
+                    .unwrap();
+            }
+        }
+        // A bar on a motor, which never falls asleep.
+        let bar = ConvexPolygon::rectangle(2.0, 0.2).unwrap();
+        let arm = world
+            .add_body(BodyDef::new(bar, 1.0).at(Vec2::new(40.0, -5.0), 0.0))
+            .unwrap();
+        let mut pin = JointDef::new(arm, None, Vec2::new(40.0, -5.0));
+        pin.motor = Some(JointMotor::new(1.0, 10.0));
+        let shoulder = world.add_joint(pin).unwrap();
+        let dt = 1.0 / 60.0;
+        for step in 0..120 {
+            let default_limit = StepSettings::default().dense_row_limit;
+            match step {
+                10 => world.settings.dense_row_limit = 100_000,
+                15 | 26 => world.settings.dense_row_limit = default_limit,
+                // The arm's island: two rows for its pin, a third for its motor.
+                20 => world.settings.dense_row_limit = 2,
+                22 | 24 => {
+                    let motor = world.joint_mut(shoulder).unwrap().motor.as_mut().unwrap();
+                    motor.enabled = step == 24;
+                }
+                _ => {}
+            }
+            let kept = world.mark_big_islands(dt);
+            let kept_marks = world.scratch.in_big_island.clone();
+            world.scratch.last_marking.found = None;
+            let fresh = world.mark_big_islands(dt);
+            assert_eq!(kept, fresh, "step {step}");
+            assert_eq!(kept_marks, world.scratch.in_big_island, "step {step}");
+            world.step(dt);
+        }
+        let asleep = world.bodies().filter(|(_, b)| b.is_asleep()).count();
+        assert_eq!(asleep, 55, "the pyramid fell asleep");
+        // Each step marks three times: the check's, the fresh one, the step's own. The
+        // first and the last are kept unless something changed: at most 240 times.
+        let kept = world.scratch.marks_kept;
+        assert!((220..=240).contains(&kept), "marks kept {kept} times");
     }
 
     /// Debris flying apart leaves its grown bounds every step, so the broad phase pairs
