@@ -1972,11 +1972,8 @@ mod tests {
             .collect()
     }
 
-    /// `auto` holds the big islands' bodies for its exact pass and the small ones' for its
-    /// soft pass: the broad phase keeps its pairs across the holds, and each pass's
-    /// candidates are exactly the overlapping pairs of which a body moves in that pass.
-    #[test]
-    fn candidates_leave_out_the_pairs_held_still_in_each_pass_of_auto() {
+    /// A 10-row pyramid of unit boxes (55, a big island) on a floor, under `auto`, g = 10.
+    fn pyramid_under_auto() -> World {
         let mut world = World::new(Vec2::new(0.0, 10.0));
         world.settings.contact_solver = ContactSolver::Auto;
         let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
@@ -1984,7 +1981,6 @@ mod tests {
             .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
             .unwrap();
         let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-        // A 10-row pyramid (a big island) and, apart, two stacks of two (small ones).
         for row in 0..10 {
             for i in 0..10 - row {
                 let at = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
@@ -1993,6 +1989,17 @@ mod tests {
                     .unwrap();
             }
         }
+        world
+    }
+
+    /// `auto` holds the big islands' bodies for its exact pass and the small ones' for its
+    /// soft pass: the broad phase keeps its pairs across the holds, and each pass's
+    /// candidates are exactly the overlapping pairs of which a body moves in that pass.
+    #[test]
+    fn candidates_leave_out_the_pairs_held_still_in_each_pass_of_auto() {
+        let mut world = pyramid_under_auto();
+        // Apart from the pyramid (a big island), two stacks of two (small ones).
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
         for x in [20.0, 25.0] {
             for y in [-0.5, -1.5] {
                 let def = BodyDef::new(unit.clone(), 1.0).at(Vec2::new(x, y), 0.1);
@@ -2027,22 +2034,8 @@ mod tests {
     /// as its motor is switched off and on, and the pyramid falling asleep.
     #[test]
     fn big_islands_are_marked_again_whenever_what_they_are_made_from_changes() {
-        let mut world = World::new(Vec2::new(0.0, 10.0));
-        world.settings.contact_solver = ContactSolver::Auto;
+        let mut world = pyramid_under_auto();
         world.settings.sleeping = true;
-        let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
-        world
-            .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
-            .unwrap();
-        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-        for row in 0..10 {
-            for i in 0..10 - row {
-                let at = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
-                world
-                    .add_body(BodyDef::new(unit.clone(), 1.0).at(at, 0.0))
-                    .unwrap();
-            }
-        }
         // A bar on a motor, which never falls asleep.
         let bar = ConvexPolygon::rectangle(2.0, 0.2).unwrap();
         let arm = world
