@@ -224,17 +224,15 @@ fn run_pe_alone() {
     {
         harness::fixed_steps(steps);
     }
+    let defaults = PeConfig::new(solver);
     let config = PeConfig {
         reuse_manifolds: !flags.iter().any(|f| f == "fresh"),
         soft_alternating_sweeps: !flags.iter().any(|f| f == "forwards"),
-        ..PeConfig::new(solver)
-    };
-    let config = PeConfig {
         soft_substeps: flags
             .iter()
             .find_map(|f| f.strip_prefix("substeps=")?.parse().ok())
-            .unwrap_or(config.soft_substeps),
-        ..config
+            .unwrap_or(defaults.soft_substeps),
+        ..defaults
     };
     let outcome = if let Some(spec) = PYRAMIDS.iter().find(|p| p.name == scene) {
         pe_scenes::pyramid(config, spec, H)

@@ -1255,7 +1255,8 @@ impl World {
             small |= moving(i) && !is_big;
         }
         let last = &mut s.last_marking;
-        last.links.clone_from(&s.auto_links);
+        // The last links go back to be the buffer for the next marking's.
+        std::mem::swap(&mut last.links, &mut s.auto_links);
         last.candidates.clone_from(&s.pairs);
         last.fixed.clone_from(&s.fat_fixed);
         last.row_limit = limit;

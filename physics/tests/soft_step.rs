@@ -501,9 +501,10 @@ fn a_net_hanging_from_its_top_row_rests_where_its_soft_pins_carry_the_rows_below
         } else {
             2.0 * (n - 1 - r) as f64 * G / (omega * omega)
         };
-        // Within 1e-9 of the largest gap, a thousand times the round-off the passes reach
-        // in 5 s: the bound holds the passes' convergence too (in a slower order, colours
-        // in tiles of 64 pins, they were 3.4e-11 m off after 10 s, and failed it).
+        // Within 1e-12 m, about 1e-9 of the largest gap (1.4e-3 m) and a thousand times
+        // the round-off the passes reach in 5 s: the bound holds the passes' convergence
+        // too (in a slower order, colours in tiles of 64 pins, they were 3.4e-11 m off
+        // after 10 s, and failed it).
         assert!(
             (gap - expected).abs() < 1e-12,
             "pin under row {r} (down: {hangs}) open {gap} m, against {expected}"
