@@ -1133,15 +1133,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let (dx, dy) = (dpx_a - dpx_b, dpy_a - dpy_b);
         let one = L::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
-        let separation = |p: &LanePoints<L>| {
-            let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
-            let turned_b = (cos_b - one) * p.reach_b + sin_b * p.normal_lever_b;
-            moved + turned_a - turned_b + p.base_separation
-        };
-        // A loop, not `array::from_fn`, whose closure the compiler left out of line.
+        // A loop without a closure, which the compiler left out of line.
         let mut separations = [L::splat(0.0); N];
         for (s, p) in separations.iter_mut().zip(&self.points) {
-            *s = separation(p);
+            let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
+            let turned_b = (cos_b - one) * p.reach_b + sin_b * p.normal_lever_b;
+            *s = moved + turned_a - turned_b + p.base_separation;
         }
         separations
     }
@@ -1150,7 +1147,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// lanes whose points differ in softness (one speculative, one touching), which solve
     /// them one after the other; both are computed there, and the lane's chosen.
     #[inline(always)]
-    fn solve_normals_together(
+    fn solve_normals_together<const BIAS: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         separations: &[L],
@@ -1160,8 +1157,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let zero = L::splat(0.0);
         let normal = (self.normal_x, self.normal_y);
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
-        let soft_differs =
-            pass.use_bias && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
+        let soft_differs = BIAS && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
         // Copied only when needed: the velocities and impulses, and the bounce lanes of a
         // batch that may bounce.
         let one_by_one = (soft_differs && mixed.any()).then(|| {
@@ -1175,11 +1171,11 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             approach(&mut self.bounce[0], v1, separations[0]);
             approach(&mut self.bounce[1], v2, separations[1]);
         }
-        self.solve_block(pair, [v1, v2], [targets[0], targets[1]]);
+        self.solve_block::<BIAS>(pair, [v1, v2], [targets[0], targets[1]]);
         if let Some((mut alone, mut impulses, mut bounce)) = one_by_one {
             let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
             let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
-            solve_normals_alone(&mut alone, alone_points, normal, separations, targets);
+            solve_normals_alone::<L, BIAS>(&mut alone, alone_points, normal, separations, targets);
             *pair = LanePair::select(mixed, alone, *pair);
             for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
                 p.set(mixed.select(q, *p));
@@ -1198,7 +1194,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// `solve_normal_pair` on every lane: the active set of each lane's 2 × 2 LCP chosen
     /// by masks.
     #[inline(always)]
-    fn solve_block(
+    fn solve_block<const BIAS: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         [v1, v2]: [L; 2],
@@ -1208,9 +1204,19 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let points = &self.points[..];
         let [x1, x2] = [self.normal_impulses[0], self.normal_impulses[1]];
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
-        let spring12 = k12.min(zero);
-        let r1 = ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2);
-        let r2 = ms2 * (v2 - t2) - (k12 * x1 + k22 * x2) + s2 * (spring12 * x1 + k22 * x2);
+        let (r1, r2) = if BIAS {
+            let spring12 = k12.min(zero);
+            (
+                ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2),
+                ms2 * (v2 - t2) - (k12 * x1 + k22 * x2) + s2 * (spring12 * x1 + k22 * x2),
+            )
+        } else {
+            // Mass scale 1 and impulse scale 0 (`solve_lanes`).
+            (
+                (v1 - t1) - (k11 * x1 + k12 * x2),
+                (v2 - t2) - (k12 * x1 + k22 * x2),
+            )
+        };
         let [i11, i12, i22] = self.inverse;
         let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
         let first = -r1 * points[0].normal_mass;
@@ -1262,6 +1268,22 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
     /// `solve_pair` on every lane.
     #[inline(always)]
     fn solve_lanes(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
+        // The relax pass (no bias) has mass scale 1 and impulse scale 0 in every lane;
+        // compiled apart, it leaves out the terms they multiply. The same bits: x · 1 is
+        // x, and leaving out a term of 0 · y can only turn a zero's sign, which the
+        // clamp at 0 (`apply_normal`) then drops.
+        if pass.use_bias {
+            self.solve_pass::<true>(bodies, pass);
+        } else {
+            self.solve_pass::<false>(bodies, pass);
+        }
+    }
+}
+
+impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
+    /// `solve_pair` on every lane, `BIAS` being `pass.use_bias`.
+    #[inline(always)]
+    fn solve_pass<const BIAS: bool>(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
         assert!(
             self.indices_fit(bodies),
             "a batch's bodies are the solver's"
@@ -1275,7 +1297,7 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
         // with bias (or rigid in the relax pass).
         let target = |s: L| {
             let speculative = s.gt(zero);
-            let (target, mass_scale, impulse_scale) = if pass.use_bias {
+            let (target, mass_scale, impulse_scale) = if BIAS {
                 let bias = -(L::splat(pass.soft.bias_rate) * s).max(L::splat(-pass.max_push));
                 (
                     bias,
@@ -1296,11 +1318,11 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
             *t = target(s);
         }
         if N == 2 {
-            self.solve_normals_together(&mut pair, &separations, &targets, pass);
+            self.solve_normals_together::<BIAS>(&mut pair, &separations, &targets, pass);
         } else {
             let bounce = self.may_bounce().then_some(&mut self.bounce[..]);
             let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
-            solve_normals_alone(&mut pair, points, normal, &separations, &targets);
+            solve_normals_alone::<L, BIAS>(&mut pair, points, normal, &separations, &targets);
         }
         let tangent = (-self.normal_y, self.normal_x);
         for (p, &normal_impulse) in self.points.iter_mut().zip(&self.normal_impulses) {
@@ -1360,7 +1382,7 @@ type PointsOf<'a, L> = (
 
 /// `solve_normal` on every lane, point after point.
 #[inline(always)]
-fn solve_normals_alone<L: Lanes>(
+fn solve_normals_alone<L: Lanes, const BIAS: bool>(
     pair: &mut LanePair<L>,
     (points, impulses, mut bounce): PointsOf<L>,
     normal: (L, L),
@@ -1375,7 +1397,11 @@ fn solve_normals_alone<L: Lanes>(
             approach(b, vn, separations[k]);
         }
         let accumulated = *impulse;
-        let change = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * accumulated;
+        let change = if BIAS {
+            -p.normal_mass * mass_scale * (vn - target) - impulse_scale * accumulated
+        } else {
+            -p.normal_mass * (vn - target)
+        };
         apply_normal(pair, (p, impulse), bounce, normal, accumulated + change);
     }
 }
