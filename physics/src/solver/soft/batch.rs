@@ -1147,7 +1147,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// lanes whose points differ in softness (one speculative, one touching), which solve
     /// them one after the other; both are computed there, and the lane's chosen.
     #[inline(always)]
-    fn solve_normals_together<const BIAS: bool>(
+    fn solve_normals_together<const BIAS: bool, const BOUNCE: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         separations: &[L],
@@ -1161,17 +1161,17 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         // Copied only when needed: the velocities and impulses, and the bounce lanes of a
         // batch that may bounce.
         let one_by_one = (soft_differs && mixed.any()).then(|| {
-            let bounce = self.may_bounce().then_some(self.bounce);
+            let bounce = BOUNCE.then_some(self.bounce);
             (*pair, self.normal_impulses, bounce)
         });
         let points = &self.points[..];
         let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
         let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
-        if self.may_bounce() {
+        if BOUNCE {
             approach(&mut self.bounce[0], v1, separations[0]);
             approach(&mut self.bounce[1], v2, separations[1]);
         }
-        self.solve_block::<BIAS>(pair, [v1, v2], [targets[0], targets[1]]);
+        self.solve_block::<BIAS, BOUNCE>(pair, [v1, v2], [targets[0], targets[1]]);
         if let Some((mut alone, mut impulses, mut bounce)) = one_by_one {
             let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
             let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
@@ -1194,7 +1194,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// `solve_normal_pair` on every lane: the active set of each lane's 2 × 2 LCP chosen
     /// by masks.
     #[inline(always)]
-    fn solve_block<const BIAS: bool>(
+    fn solve_block<const BIAS: bool, const BOUNCE: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         [v1, v2]: [L; 2],
@@ -1230,7 +1230,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             take_first.select(zero, take_second.select(second, zero)),
         );
         let normal = (self.normal_x, self.normal_y);
-        let may_bounce = self.may_bounce();
+        let may_bounce = BOUNCE;
         let points = self.points.iter().zip(&mut self.normal_impulses);
         for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
             apply_normal(
@@ -1271,11 +1271,14 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
         // The relax pass (no bias) has mass scale 1 and impulse scale 0 in every lane;
         // compiled apart, it leaves out the terms they multiply. The same bits: x · 1 is
         // x, and leaving out a term of 0 · y can only turn a zero's sign, which the
-        // clamp at 0 (`apply_normal`) then drops.
-        if pass.use_bias {
-            self.solve_pass::<true>(bodies, pass);
-        } else {
-            self.solve_pass::<false>(bodies, pass);
+        // clamp at 0 (`apply_normal`) then drops. And a batch with no lane that may
+        // bounce (every batch of a pile) is compiled without the bounce lanes' code,
+        // which otherwise took registers the passes spilled for.
+        match (pass.use_bias, self.may_bounce()) {
+            (true, false) => self.solve_pass::<true, false>(bodies, pass),
+            (false, false) => self.solve_pass::<false, false>(bodies, pass),
+            (true, true) => self.solve_pass::<true, true>(bodies, pass),
+            (false, true) => self.solve_pass::<false, true>(bodies, pass),
         }
     }
 }
@@ -1283,7 +1286,11 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
 impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// `solve_pair` on every lane, `BIAS` being `pass.use_bias`.
     #[inline(always)]
-    fn solve_pass<const BIAS: bool>(&mut self, bodies: &mut [SoftBody], pass: &PassSettings) {
+    fn solve_pass<const BIAS: bool, const BOUNCE: bool>(
+        &mut self,
+        bodies: &mut [SoftBody],
+        pass: &PassSettings,
+    ) {
         assert!(
             self.indices_fit(bodies),
             "a batch's bodies are the solver's"
@@ -1318,9 +1325,9 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             *t = target(s);
         }
         if N == 2 {
-            self.solve_normals_together::<BIAS>(&mut pair, &separations, &targets, pass);
+            self.solve_normals_together::<BIAS, BOUNCE>(&mut pair, &separations, &targets, pass);
         } else {
-            let bounce = self.may_bounce().then_some(&mut self.bounce[..]);
+            let bounce = BOUNCE.then_some(&mut self.bounce[..]);
             let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
             solve_normals_alone::<L, BIAS>(&mut pair, points, normal, &separations, &targets);
         }
