@@ -1284,7 +1284,8 @@ impl<const N: usize, L: Lanes> BatchLanes<PassSettings> for ManifoldBatch<N, L> 
 }
 
 impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
-    /// `solve_pair` on every lane, `BIAS` being `pass.use_bias`.
+    /// `solve_pair` on every lane, `BIAS` being `pass.use_bias` and `BOUNCE`
+    /// `self.may_bounce()`.
     #[inline(always)]
     fn solve_pass<const BIAS: bool, const BOUNCE: bool>(
         &mut self,
