@@ -1158,12 +1158,43 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let normal = (self.normal_x, self.normal_y);
         let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
         let soft_differs = BIAS && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
-        // Copied only when needed: the velocities and impulses, and the bounce lanes of a
-        // batch that may bounce.
-        let one_by_one = (soft_differs && mixed.any()).then(|| {
-            let bounce = BOUNCE.then_some(self.bounce);
-            (*pair, self.normal_impulses, bounce)
-        });
+        if !(soft_differs && mixed.any()) {
+            // Apart from the rarer case below, whose copies would take its registers.
+            self.solve_normals_as_block::<BIAS, BOUNCE>(pair, separations, targets);
+            return;
+        }
+        // Copied before the block changes them: the velocities and impulses, and the
+        // bounce lanes of a batch that may bounce.
+        let (mut alone, mut impulses) = (*pair, self.normal_impulses);
+        let mut bounce = BOUNCE.then_some(self.bounce);
+        self.solve_normals_as_block::<BIAS, BOUNCE>(pair, separations, targets);
+        let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
+        let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
+        solve_normals_alone::<L, BIAS>(&mut alone, alone_points, normal, separations, targets);
+        *pair = LanePair::select(mixed, alone, *pair);
+        for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
+            p.set(mixed.select(q, *p));
+        }
+        if let Some(bounce) = bounce {
+            for (p, q) in self.bounce.iter_mut().zip(bounce) {
+                let largest = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
+                p.max_normal_impulse.set(largest);
+                let fastest = mixed.select(q.relative_velocity, p.relative_velocity);
+                p.relative_velocity.set(fastest);
+            }
+        }
+    }
+
+    /// Both points' normal velocities, their approach where they may bounce, and the
+    /// 2 × 2 block (`solve_block`).
+    #[inline(always)]
+    fn solve_normals_as_block<const BIAS: bool, const BOUNCE: bool>(
+        &mut self,
+        pair: &mut LanePair<L>,
+        separations: &[L],
+        targets: &[Target<L>],
+    ) {
+        let normal = (self.normal_x, self.normal_y);
         let points = &self.points[..];
         let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
         let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
@@ -1172,23 +1203,6 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             approach(&mut self.bounce[1], v2, separations[1]);
         }
         self.solve_block::<BIAS, BOUNCE>(pair, [v1, v2], [targets[0], targets[1]]);
-        if let Some((mut alone, mut impulses, mut bounce)) = one_by_one {
-            let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
-            let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
-            solve_normals_alone::<L, BIAS>(&mut alone, alone_points, normal, separations, targets);
-            *pair = LanePair::select(mixed, alone, *pair);
-            for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
-                p.set(mixed.select(q, *p));
-            }
-            if let Some(bounce) = bounce {
-                for (p, q) in self.bounce.iter_mut().zip(bounce) {
-                    let largest = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
-                    p.max_normal_impulse.set(largest);
-                    let fastest = mixed.select(q.relative_velocity, p.relative_velocity);
-                    p.relative_velocity.set(fastest);
-                }
-            }
-        }
     }
 
     /// `solve_normal_pair` on every lane: the active set of each lane's 2 × 2 LCP chosen
