@@ -1133,7 +1133,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let (dx, dy) = (dpx_a - dpx_b, dpy_a - dpy_b);
         let one = L::splat(1.0);
         let moved = dx * self.normal_x + dy * self.normal_y;
-        // A loop without a closure, which the compiler left out of line.
+        // Written out in the loop: a closure here was left out of line.
         let mut separations = [L::splat(0.0); N];
         for (s, p) in separations.iter_mut().zip(&self.points) {
             let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
@@ -1244,16 +1244,9 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             take_first.select(zero, take_second.select(second, zero)),
         );
         let normal = (self.normal_x, self.normal_y);
-        let may_bounce = BOUNCE;
         let points = self.points.iter().zip(&mut self.normal_impulses);
         for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
-            apply_normal(
-                pair,
-                (p, impulse),
-                may_bounce.then_some(bounce),
-                normal,
-                total,
-            );
+            apply_normal(pair, (p, impulse), BOUNCE.then_some(bounce), normal, total);
         }
     }
 }
