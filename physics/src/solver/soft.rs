@@ -16,7 +16,7 @@ use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
-use batch::{LaneBatch, LanePath, PassItem, PassPlan, PassSettings, PlanInput};
+use batch::{LaneBatch, LanePath, ManifoldBatch, PassItem, PassPlan, PassSettings, PlanInput};
 use pins::{PinPass, PinPlan};
 
 #[cfg(target_arch = "x86_64")]
@@ -982,9 +982,22 @@ impl SoftStepSolver {
         // In the plan's order: small islands in the points' order, then big ones colour
         // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
         let coloured_from = self.plan.coloured_from;
+        let ask_ahead_in_passes = self.plan.ask_ahead_in_passes();
         let (items, batches, point_batches) = self.plan.work();
         let (small, coloured) = items.split_at(coloured_from);
         let lanes = LanePath::best();
+        // Where the batches lie, only to ask for the next one's lines (`ask_ahead`).
+        let (pair_batches_at, point_batches_at) = (batches.as_ptr(), point_batches.as_ptr());
+        let ask_ahead = |item: Option<&PassItem>| match item {
+            _ if !ask_ahead_in_passes => {}
+            Some(&PassItem::Batch(k)) => {
+                ManifoldBatch::prefetch(pair_batches_at.wrapping_add(k as usize))
+            }
+            Some(&PassItem::PointBatch(k)) => {
+                ManifoldBatch::prefetch(point_batches_at.wrapping_add(k as usize))
+            }
+            _ => {}
+        };
         let mut solve_item = |item: &PassItem| match *item {
             PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, &pass),
             PassItem::PointBatch(k) => {
@@ -1001,8 +1014,18 @@ impl SoftStepSolver {
         };
         small.iter().for_each(&mut solve_item);
         match order {
-            SweepOrder::Forwards => coloured.iter().for_each(solve_item),
-            SweepOrder::Backwards => coloured.iter().rev().for_each(solve_item),
+            SweepOrder::Forwards => {
+                for (i, item) in coloured.iter().enumerate() {
+                    ask_ahead(coloured.get(i + 1));
+                    solve_item(item);
+                }
+            }
+            SweepOrder::Backwards => {
+                for (i, item) in coloured.iter().enumerate().rev() {
+                    ask_ahead(i.checked_sub(1).map(|before| &coloured[before]));
+                    solve_item(item);
+                }
+            }
         }
     }
 
