@@ -891,7 +891,18 @@ impl SoftStepSolver {
         }
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         let lanes = LanePath::best();
-        for item in &self.plan.items {
+        let ask_ahead = self.plan.ask_ahead_in_passes();
+        for (i, item) in self.plan.items.iter().enumerate() {
+            match self.plan.items.get(i + 1) {
+                _ if !ask_ahead => {}
+                Some(&PassItem::Batch(k)) => {
+                    ManifoldBatch::prefetch_for_warm_start(&batches[k as usize])
+                }
+                Some(&PassItem::PointBatch(k)) => {
+                    ManifoldBatch::prefetch_for_warm_start(&point_batches[k as usize])
+                }
+                _ => {}
+            }
             match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
                 PassItem::PointBatch(k) => {
