@@ -997,8 +997,8 @@ impl<const N: usize> ManifoldBatch<N> {
         prefetch_bytes(batch.cast(), std::mem::offset_of!(Self, bounce));
     }
 
-    /// Asks the cache for what the warm start reads of the batch at `batch` (18 of a
-    /// two-point batch's 31 lines), as `prefetch`. Asked for whole, the warm start took
+    /// Asks the cache for what the warm start reads of the batch at `batch` (18 of the 31
+    /// lines a pass reads of a two-point batch), as `prefetch`. Asked for whole, the warm start took
     /// no less time; asked for these, large_pyramid's took 5–15% less on the Zen 1 and
     /// the smash's 10–30%.
     #[inline(always)]
