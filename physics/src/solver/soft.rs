@@ -16,7 +16,7 @@ use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
-use batch::{LaneBatch, LanePath, ManifoldBatch, PassItem, PassPlan, PassSettings, PlanInput};
+use batch::{AskedFor, LaneBatch, LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 use pins::{PinPass, PinPlan};
 
 #[cfg(target_arch = "x86_64")]
@@ -891,18 +891,9 @@ impl SoftStepSolver {
         }
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         let lanes = LanePath::best();
-        let ask_ahead = self.plan.ask_ahead_in_passes();
+        let ahead = self.plan.batches_ahead();
         for (i, item) in self.plan.items.iter().enumerate() {
-            match self.plan.items.get(i + 1) {
-                _ if !ask_ahead => {}
-                Some(&PassItem::Batch(k)) => {
-                    ManifoldBatch::prefetch_for_warm_start(&batches[k as usize])
-                }
-                Some(&PassItem::PointBatch(k)) => {
-                    ManifoldBatch::prefetch_for_warm_start(&point_batches[k as usize])
-                }
-                _ => {}
-            }
+            ahead.ask_for(self.plan.items.get(i + 1), AskedFor::WarmStart);
             match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
                 PassItem::PointBatch(k) => {
@@ -993,22 +984,10 @@ impl SoftStepSolver {
         // In the plan's order: small islands in the points' order, then big ones colour
         // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
         let coloured_from = self.plan.coloured_from;
-        let ask_ahead_in_passes = self.plan.ask_ahead_in_passes();
+        let ahead = self.plan.batches_ahead();
         let (items, batches, point_batches) = self.plan.work();
         let (small, coloured) = items.split_at(coloured_from);
         let lanes = LanePath::best();
-        // Where the batches lie, only to ask for the next one's lines (`ask_ahead`).
-        let (pair_batches_at, point_batches_at) = (batches.as_ptr(), point_batches.as_ptr());
-        let ask_ahead = |item: Option<&PassItem>| match item {
-            _ if !ask_ahead_in_passes => {}
-            Some(&PassItem::Batch(k)) => {
-                ManifoldBatch::prefetch(pair_batches_at.wrapping_add(k as usize))
-            }
-            Some(&PassItem::PointBatch(k)) => {
-                ManifoldBatch::prefetch(point_batches_at.wrapping_add(k as usize))
-            }
-            _ => {}
-        };
         let mut solve_item = |item: &PassItem| match *item {
             PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, &pass),
             PassItem::PointBatch(k) => {
@@ -1027,13 +1006,14 @@ impl SoftStepSolver {
         match order {
             SweepOrder::Forwards => {
                 for (i, item) in coloured.iter().enumerate() {
-                    ask_ahead(coloured.get(i + 1));
+                    ahead.ask_for(coloured.get(i + 1), AskedFor::Pass);
                     solve_item(item);
                 }
             }
             SweepOrder::Backwards => {
                 for (i, item) in coloured.iter().enumerate().rev() {
-                    ask_ahead(i.checked_sub(1).map(|before| &coloured[before]));
+                    let before = i.checked_sub(1).map(|before| &coloured[before]);
+                    ahead.ask_for(before, AskedFor::Pass);
                     solve_item(item);
                 }
             }

@@ -51,12 +51,52 @@ const MIN_COLOURED_ISLAND: usize = 48;
 const PREFETCH_AHEAD: usize = 16;
 
 /// From how many bytes of batches the passes ask for each next batch while solving one
-/// (`PassPlan::ask_ahead_in_passes`). More than a level-2 cache holds beside the bodies,
+/// (`PassPlan::batches_ahead`). More than a level-2 cache holds beside the bodies,
 /// they come from farther out in every pass, and the first reads of each batch waited:
 /// asked for ahead, the smash's passes took 30% less time on the Zen 1, large_pyramid's
 /// and many_pyramids' 15–25%. A pile that stays in the cache gains nothing and pays for
 /// the asking (pyramid20's passes 3% slower). The warm start asks for what it reads too.
 const ASK_AHEAD_FROM_BYTES: usize = 256 * 1024;
+
+/// Where the step's batches lie (`PassPlan::batches_ahead`), kept apart from their
+/// borrow so that a pass holding them mutably can still ask for the next one. The
+/// pointers are only ever prefetched from, never read through.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BatchesAhead {
+    pairs: *const ManifoldBatch<2>,
+    singles: *const ManifoldBatch<1>,
+    on: bool,
+}
+
+/// What a batch is asked for ahead of: a pass reads most of it, the warm start less.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum AskedFor {
+    Pass,
+    WarmStart,
+}
+
+impl BatchesAhead {
+    /// Asks the cache for what `reader` will read of `item`'s batch, if it is one.
+    #[inline(always)]
+    pub fn ask_for(self, item: Option<&PassItem>, reader: AskedFor) {
+        match (item, reader) {
+            _ if !self.on => {}
+            (Some(&PassItem::Batch(k)), AskedFor::Pass) => {
+                ManifoldBatch::prefetch(self.pairs.wrapping_add(k as usize))
+            }
+            (Some(&PassItem::Batch(k)), AskedFor::WarmStart) => {
+                ManifoldBatch::prefetch_for_warm_start(self.pairs.wrapping_add(k as usize))
+            }
+            (Some(&PassItem::PointBatch(k)), AskedFor::Pass) => {
+                ManifoldBatch::prefetch(self.singles.wrapping_add(k as usize))
+            }
+            (Some(&PassItem::PointBatch(k)), AskedFor::WarmStart) => {
+                ManifoldBatch::prefetch_for_warm_start(self.singles.wrapping_add(k as usize))
+            }
+            _ => {}
+        }
+    }
+}
 
 /// A manifold of a coloured island, as `plan` sorts them.
 #[derive(Debug, Clone, Copy)]
@@ -435,12 +475,17 @@ impl PassPlan {
         self.singles.filled()
     }
 
-    /// Whether the passes ask for each next batch while solving one: the step's batches
-    /// are too many to stay in the cache (`ASK_AHEAD_FROM_BYTES`).
-    pub fn ask_ahead_in_passes(&self) -> bool {
+    /// Where the step's batches lie, for the passes to ask for each next one while
+    /// solving one, if the batches are too many to stay in the cache
+    /// (`ASK_AHEAD_FROM_BYTES`).
+    pub fn batches_ahead(&self) -> BatchesAhead {
         let bytes =
             std::mem::size_of_val(self.batches()) + std::mem::size_of_val(self.point_batches());
-        bytes >= ASK_AHEAD_FROM_BYTES
+        BatchesAhead {
+            pairs: self.batches().as_ptr(),
+            singles: self.point_batches().as_ptr(),
+            on: bytes >= ASK_AHEAD_FROM_BYTES,
+        }
     }
 
     /// The step's work and its batches, to solve them.
@@ -993,16 +1038,16 @@ impl<const N: usize> ManifoldBatch<N> {
     /// Asks the cache for what a pass reads of the batch at `batch` (all but its bounce
     /// lanes), ahead of solving it. `batch` need not point at a batch (`prefetch_bytes`).
     #[inline(always)]
-    pub(super) fn prefetch(batch: *const Self) {
+    fn prefetch(batch: *const Self) {
         prefetch_bytes(batch.cast(), std::mem::offset_of!(Self, bounce));
     }
 
     /// Asks the cache for what the warm start reads of the batch at `batch` (18 of the 31
-    /// lines a pass reads of a two-point batch), as `prefetch`. Asked for whole, the warm start took
-    /// no less time; asked for these, large_pyramid's took 5–15% less on the Zen 1 and
-    /// the smash's 10–30%.
+    /// lines a pass reads of a two-point batch), as `prefetch`. Asked for whole, the warm
+    /// start took no less time; asked for these, large_pyramid's took 5–15% less on the
+    /// Zen 1 and the smash's 10–30%.
     #[inline(always)]
-    pub(super) fn prefetch_for_warm_start(batch: *const Self) {
+    fn prefetch_for_warm_start(batch: *const Self) {
         use std::mem::{offset_of, size_of};
         let at = |offset: usize| batch.cast::<u8>().wrapping_add(offset);
         prefetch_bytes(at(0), offset_of!(Self, friction));
