@@ -104,6 +104,14 @@ fn run_row(
 type Job<'a> = Box<dyn FnOnce() -> Outcome + Send + 'a>;
 
 fn main() {
+    if !PeerBuild::CURRENT.runs_here() {
+        eprintln!(
+            "this build runs Box2D v3 and rapier2d in AVX2, which this processor lacks: \
+             build with `cargo run --release --no-default-features` (the peers' default \
+             lanes)"
+        );
+        std::process::exit(2);
+    }
     let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench");
     let load = load_average();
     harness::pin_to_the_benchmark_core();
@@ -112,10 +120,13 @@ fn main() {
         let mut md = sweep::run(docs);
         let _ = writeln!(
             md,
-            "Machine: {}; load average at start: {load}; {}; whole sweep {:.0} s.",
+            "Machine: {}; load average at start: {load}; {}; whole sweep {:.0} s. \
+             rapier2d: {}; Box2D v3: {}; every engine compiled for this processor.",
             machine(),
             today(),
-            started.elapsed().as_secs_f64()
+            started.elapsed().as_secs_f64(),
+            PeerBuild::CURRENT.rapier2d(),
+            PeerBuild::CURRENT.box2d(),
         );
         write_doc(docs, "sweep.md", &md);
         return;
@@ -521,13 +532,16 @@ fn report(
     let _ = writeln!(
         w,
         "- Engines: pe (this repository, f64) with contact solvers `{}`; rapier2d {} \
-         (f32, default features, one thread), default `IntegrationParameters` except `dt`, \
+         (f32, {}, one thread), default `IntegrationParameters` except `dt`, \
          every body with `can_sleep(false)`; Box2D v3 through boxdd {} (Box2D's C \
-         sources built by cc, f32, one thread), default world settings with {} substeps, \
-         sleeping off.",
+         sources built by cc, f32, {}, one thread), default world settings with {} \
+         substeps, sleeping off. Every engine compiled for this processor \
+         (`target-cpu=native`, bench/.cargo/config.toml).",
         names.join("`, `"),
         rapier_version(),
+        PeerBuild::CURRENT.rapier2d(),
         locked_version("boxdd"),
+        PeerBuild::CURRENT.box2d(),
         box2d_scenes::SUBSTEPS
     );
     let _ = writeln!(
@@ -804,6 +818,48 @@ fn machine() -> String {
 }
 
 /// The rapier2d version actually built, from this crate's lock file.
+/// How the peers were built (bench/Cargo.toml, feature `fastest-peers`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum PeerBuild {
+    /// Box2D v3 with `BOX2D_AVX2`, rapier2d with eight solver lanes: each one's fastest
+    /// on a processor with AVX2.
+    Fastest,
+    /// Both as their default features build them: four f32 lanes in SSE2.
+    Default,
+}
+
+impl PeerBuild {
+    const CURRENT: Self = if cfg!(feature = "fastest-peers") {
+        Self::Fastest
+    } else {
+        Self::Default
+    };
+
+    fn rapier2d(self) -> &'static str {
+        match self {
+            Self::Fastest => "feature `simd8`: eight solver lanes, in AVX2",
+            Self::Default => "default features: four solver lanes",
+        }
+    }
+
+    fn box2d(self) -> &'static str {
+        match self {
+            Self::Fastest => "`BOX2D_AVX2`: eight lanes in AVX2",
+            Self::Default => "boxdd's default: four lanes in SSE2",
+        }
+    }
+
+    /// Whether this processor runs the build: Box2D's AVX2 build would stop at its
+    /// first vector instruction on one without.
+    fn runs_here(self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self == Self::Fastest {
+            return std::arch::is_x86_feature_detected!("avx2");
+        }
+        true
+    }
+}
+
 fn rapier_version() -> &'static str {
     locked_version("rapier2d")
 }
