@@ -817,7 +817,6 @@ fn machine() -> String {
     )
 }
 
-/// The rapier2d version actually built, from this crate's lock file.
 /// How the peers were built (bench/Cargo.toml, feature `fastest-peers`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum PeerBuild {
@@ -860,6 +859,7 @@ impl PeerBuild {
     }
 }
 
+/// The rapier2d version actually built, from this crate's lock file.
 fn rapier_version() -> &'static str {
     locked_version("rapier2d")
 }
