@@ -892,9 +892,10 @@ impl SoftStepSolver {
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         let lanes = LanePath::best();
         let ahead = self.plan.batches_ahead();
-        for (i, item) in self.plan.items.iter().enumerate() {
-            ahead.ask_for(self.plan.items.get(i + 1), AskedFor::WarmStart);
-            match *item {
+        ahead.visit(
+            self.plan.items.iter(),
+            AskedFor::WarmStart,
+            |item| match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
                 PassItem::PointBatch(k) => {
                     point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
@@ -905,8 +906,8 @@ impl SoftStepSolver {
                         warm_start_point(&mut self.bodies, p);
                     }
                 }
-            }
-        }
+            },
+        );
         // Each pin's impulse and its motor's, pin by pin; the batched islands' pins, then
         // their motors'.
         for &(start, end) in &self.joint_islands {
@@ -1004,19 +1005,8 @@ impl SoftStepSolver {
         };
         small.iter().for_each(&mut solve_item);
         match order {
-            SweepOrder::Forwards => {
-                for (i, item) in coloured.iter().enumerate() {
-                    ahead.ask_for(coloured.get(i + 1), AskedFor::Pass);
-                    solve_item(item);
-                }
-            }
-            SweepOrder::Backwards => {
-                for (i, item) in coloured.iter().enumerate().rev() {
-                    let before = i.checked_sub(1).map(|before| &coloured[before]);
-                    ahead.ask_for(before, AskedFor::Pass);
-                    solve_item(item);
-                }
-            }
+            SweepOrder::Forwards => ahead.visit(coloured.iter(), AskedFor::Pass, solve_item),
+            SweepOrder::Backwards => ahead.visit(coloured.iter().rev(), AskedFor::Pass, solve_item),
         }
     }
 

@@ -76,9 +76,25 @@ pub(super) enum AskedFor {
 }
 
 impl BatchesAhead {
+    /// Hands `items` to `visit` in their order, asking for what `reader` will read of
+    /// each next one's batch while the one before is visited.
+    #[inline(always)]
+    pub fn visit<'a>(
+        self,
+        items: impl Iterator<Item = &'a PassItem>,
+        reader: AskedFor,
+        mut visit: impl FnMut(&'a PassItem),
+    ) {
+        let mut items = items.peekable();
+        while let Some(item) = items.next() {
+            self.ask_for(items.peek().copied(), reader);
+            visit(item);
+        }
+    }
+
     /// Asks the cache for what `reader` will read of `item`'s batch, if it is one.
     #[inline(always)]
-    pub fn ask_for(self, item: Option<&PassItem>, reader: AskedFor) {
+    fn ask_for(self, item: Option<&PassItem>, reader: AskedFor) {
         match (item, reader) {
             _ if !self.on => {}
             (Some(&PassItem::Batch(k)), AskedFor::Pass) => {
