@@ -448,6 +448,14 @@ struct JointBlock {
     rhs: Vec<f64>,
 }
 
+/// How `build_points` finds the last step's impulses: guessing each contact's entry at
+/// its own index until a guess misses, then from all of them recalled at once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Recall {
+    Guessing,
+    AllRecalled,
+}
+
 /// The most a body may turn in one substep (radians).
 const MAX_TURN_PER_SUBSTEP: f64 = 0.25 * std::f64::consts::PI;
 
@@ -660,132 +668,157 @@ impl SoftStepSolver {
         self.points.truncate(contacts.len());
         self.plan_inputs.clear();
         self.may_bounce = false;
-        // The last impulses: a pile at rest has the same contacts in the same order, each
-        // its entry at its own index (`ContactMemory::guess`); at the first that is not,
-        // every contact's are recalled at once, in the contacts' order, which the
-        // memory's follows (the points are built in the islands').
-        let mut recalled_all = false;
+        let mut recall = Recall::Guessing;
         let mut skipped = false;
-        // The manifold begun by the point before, not yet complete: its first point's
-        // index, whether its island is small (below), and where in `pending` its point
-        // is; each point is built into the other place (`next`), and never moved.
-        let mut open: Option<(usize, bool, usize)> = None;
-        let mut pending = [PointConstraint::default(); 2];
-        let mut next = 0;
-        let mut last_contact = None; // (bodies, normal)
+        // A point built already that begins the next manifold: the second of two
+        // whose block was not well conditioned.
+        let mut carried: Option<PointConstraint> = None;
         // The island of the current point: where it ends, and whether it may be an LCP
         // island (`ContactLcp::prepare`), which reads its points.
         let (mut island, mut island_end, mut small_island) = (0, 0, true);
-        // A complete manifold: into its lane, or else written to the points.
-        let mut complete =
-            |this: &mut Self, first: usize, manifold: &[&PointConstraint], small: bool| {
-                let in_lane = this.plan.fill_manifold(first, manifold, &this.bodies);
-                #[cfg(test)]
-                let small = small || this.write_every_point;
-                if in_lane && !small {
-                    skipped = true;
-                } else {
-                    for (to, p) in this.points[first..].iter_mut().zip(manifold) {
-                        *to = **p;
-                    }
-                }
-            };
-        for (k, &(_, i)) in grouped.iter().enumerate() {
+        let mut k = 0;
+        while k < grouped.len() {
             if k == island_end {
                 let (start, end) = self.contact_islands[island];
                 (island, island_end, small_island) =
                     (island + 1, end, end - start <= LCP_POINT_LIMIT);
             }
-            let (i, c) = (i as usize, &contacts[i as usize]);
-            let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-            let r_a = c.point - a.position;
-            let r_b = c.point - b.position;
-            let levers = PointLevers {
-                normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-                reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
+            let c = &contacts[grouped[k].1 as usize];
+            let mut first = match carried.take() {
+                Some(p) => p,
+                None => self.build_point(
+                    bodies,
+                    accelerations,
+                    contacts,
+                    grouped[k].1,
+                    dt,
+                    &mut recall,
+                ),
             };
-            // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
-            let mass = |levers: (f64, f64)| {
-                let inertias = (a.inv_inertia, b.inv_inertia);
-                let k = row_coupling(a.inv_mass + b.inv_mass, inertias, levers, levers);
-                if k > 0.0 { 1.0 / k } else { 0.0 }
-            };
-            let guessed = (!recalled_all).then(|| self.memory.guess(i, c)).flatten();
-            let (normal_impulse, tangent_impulse) = guessed.unwrap_or_else(|| {
-                if !recalled_all {
-                    self.memory.recall(contacts, &mut self.recalled);
-                    recalled_all = true;
-                }
-                self.recalled[i]
-            });
-            self.may_bounce |= c.restitution != 0.0;
-            // Read only for points that may bounce (`approach`).
-            let closing_acceleration = if c.restitution == 0.0 {
-                0.0
-            } else {
-                -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
-                    .dot(&c.normal)
-            };
-            pending[next] = PointConstraint {
-                contact: i as u32,
-                a: c.body_a,
-                b: c.body_b,
-                normal: c.normal,
-                levers,
-                base_separation: -c.depth,
-                normal_mass: mass(levers.normal),
-                tangent_mass: mass(levers.tangent()),
-                friction: c.friction,
-                restitution: c.restitution,
-                relative_velocity: c.approach_velocity,
-                normal_impulse,
-                tangent_impulse,
-                max_normal_impulse: 0.0,
-                closing_acceleration,
-                fastest_impact: c.approach_velocity - closing_acceleration.max(0.0) * dt,
-                pair_coupling: None,
-            };
-            let point = &pending[next];
-            // With the point before, one manifold's two points: coupled if their block
-            // is well conditioned. Whether they are one manifold's is told from the
-            // contact before.
-            let this_contact = (c.body_a, c.body_b, c.normal);
-            let same_manifold = last_contact == Some(this_contact);
-            last_contact = Some(this_contact);
-            let block = open.filter(|_| same_manifold).and_then(|(_, _, at)| {
-                let bodies = (
+            // The next contact is this manifold's second point if it joins the same
+            // bodies along the same normal; the two are coupled if their block is well
+            // conditioned. (A manifold's points share their bodies, so their island.)
+            let second = grouped
+                .get(k + 1)
+                .map(|&(_, j)| j)
+                .filter(|&j| {
+                    let d = &contacts[j as usize];
+                    (d.body_a, d.body_b, d.normal) == (c.body_a, c.body_b, c.normal)
+                })
+                .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut recall));
+            let block = second.as_ref().and_then(|q| {
+                let pair = (
                     &self.bodies[c.body_a as usize],
                     &self.bodies[c.body_b as usize],
                 );
-                NormalBlock::of(bodies, (&pending[at], point))
+                NormalBlock::of(pair, (&first, q))
             });
-            if let Some(block) = block {
-                let (first, small, at) = open.take().expect("the manifold's first point");
-                pending[at].pair_coupling = Some(block);
-                self.plan_inputs
-                    .last_mut()
-                    .expect("the first point's entry")
-                    .add_second_point();
-                complete(self, first, &[&pending[at], &pending[next]], small);
+            let moves = |i: u32| self.bodies[i as usize].moves();
+            let mut input = PlanInput::new(
+                (c.body_a, c.body_b),
+                k,
+                (moves(c.body_a), moves(c.body_b)),
+                c.normal,
+            );
+            if let (Some(block), Some(q)) = (block, second) {
+                first.pair_coupling = Some(block);
+                input.add_second_point();
+                self.plan_inputs.push(input);
+                skipped |= self.place_manifold(k, &[first, q], small_island);
+                k += 2;
             } else {
-                let moves = |i: u32| self.bodies[i as usize].moves();
-                self.plan_inputs.push(PlanInput::new(
-                    (c.body_a, c.body_b),
-                    k,
-                    (moves(c.body_a), moves(c.body_b)),
-                    c.normal,
-                ));
-                // The point before, if it began a manifold, was that manifold's only one.
-                if let Some((single, small, at)) = open.replace((k, small_island, next)) {
-                    complete(self, single, &[&pending[at]], small);
-                }
-                next = 1 - next;
+                self.plan_inputs.push(input);
+                skipped |= self.place_manifold(k, &[first], small_island);
+                carried = second;
+                k += 1;
             }
         }
-        if let Some((single, small, at)) = open {
-            complete(self, single, &[&pending[at]], small);
-        }
         skipped
+    }
+
+    /// The point of contact `i` (this step's contacts' index), its impulses recalled from
+    /// the last step.
+    #[inline(always)]
+    fn build_point(
+        &mut self,
+        bodies: &[SolverBody],
+        accelerations: &[(Vec2, f64)],
+        contacts: &[Contact],
+        i: u32,
+        dt: f64,
+        recall: &mut Recall,
+    ) -> PointConstraint {
+        let c = &contacts[i as usize];
+        let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+        let r_a = c.point - a.position;
+        let r_b = c.point - b.position;
+        let levers = PointLevers {
+            normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
+            reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
+        };
+        // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
+        let mass = |levers: (f64, f64)| {
+            let inertias = (a.inv_inertia, b.inv_inertia);
+            let k = row_coupling(a.inv_mass + b.inv_mass, inertias, levers, levers);
+            if k > 0.0 { 1.0 / k } else { 0.0 }
+        };
+        // A pile at rest has the same contacts in the same order, each its entry at its
+        // own index (`ContactMemory::guess`); at the first that is not, every contact's
+        // impulses are recalled at once, in the contacts' order, which the memory's
+        // follows (the points are built in the islands').
+        let guessed = match recall {
+            Recall::Guessing => self.memory.guess(i as usize, c),
+            Recall::AllRecalled => None,
+        };
+        let (normal_impulse, tangent_impulse) = guessed.unwrap_or_else(|| {
+            if *recall == Recall::Guessing {
+                self.memory.recall(contacts, &mut self.recalled);
+                *recall = Recall::AllRecalled;
+            }
+            self.recalled[i as usize]
+        });
+        self.may_bounce |= c.restitution != 0.0;
+        // Read only for points that may bounce (`approach`).
+        let closing_acceleration = if c.restitution == 0.0 {
+            0.0
+        } else {
+            -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
+                .dot(&c.normal)
+        };
+        PointConstraint {
+            contact: i,
+            a: c.body_a,
+            b: c.body_b,
+            normal: c.normal,
+            levers,
+            base_separation: -c.depth,
+            normal_mass: mass(levers.normal),
+            tangent_mass: mass(levers.tangent()),
+            friction: c.friction,
+            restitution: c.restitution,
+            relative_velocity: c.approach_velocity,
+            normal_impulse,
+            tangent_impulse,
+            max_normal_impulse: 0.0,
+            closing_acceleration,
+            fastest_impact: c.approach_velocity - closing_acceleration.max(0.0) * dt,
+            pair_coupling: None,
+        }
+    }
+
+    /// A complete manifold whose first point is `first`: into its lane in the kept plan,
+    /// or else written to the points. Returns whether it was left unwritten (see
+    /// `build_points`); a small island's always is written, for the LCP.
+    #[inline(always)]
+    fn place_manifold(&mut self, first: usize, manifold: &[PointConstraint], small: bool) -> bool {
+        let in_lane = self.plan.fill_manifold(first, manifold, &self.bodies);
+        #[cfg(test)]
+        let small = small || self.write_every_point;
+        if in_lane && !small {
+            return true;
+        }
+        self.points[first..first + manifold.len()].copy_from_slice(manifold);
+        false
     }
 
     /// Records how each island of contacts and of pins was solved.

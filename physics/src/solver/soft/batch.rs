@@ -407,11 +407,11 @@ impl PassPlan {
 
     /// The manifold of points `manifold` whose first point is `first`, just built, into
     /// the lane the kept plan has for it, if any and of its size: whether it went into one.
-    #[inline]
+    #[inline(always)]
     pub fn fill_manifold(
         &mut self,
         first: usize,
-        manifold: &[&PointConstraint],
+        manifold: &[PointConstraint],
         bodies: &[SoftBody],
     ) -> bool {
         if !self.filled_while_built {
@@ -1093,8 +1093,7 @@ impl<const N: usize> ManifoldBatch<N> {
                 Some(unused) if first == PAD => &unused[..],
                 _ => &points[first as usize..],
             };
-            let lane_points: [&PointConstraint; N] = std::array::from_fn(|j| &lane_points[j]);
-            self.fill_lane(k, first, &lane_points, bodies);
+            self.fill_lane(k, first, &lane_points[..N], bodies);
         }
     }
 
@@ -1104,11 +1103,11 @@ impl<const N: usize> ManifoldBatch<N> {
         &mut self,
         k: usize,
         first: u32,
-        lane_points: &[&PointConstraint],
+        lane_points: &[PointConstraint],
         bodies: &[SoftBody],
     ) {
         self.first_point[k] = first;
-        let p = lane_points[0];
+        let p = &lane_points[0];
         let (a, b) = (&bodies[p.a as usize], &bodies[p.b as usize]);
         self.a[k] = p.a;
         self.b[k] = p.b;
@@ -2075,8 +2074,7 @@ pub(super) mod tests {
         plan.begin_filling();
         for input in inputs_of(&points, &bodies) {
             let (first, count) = (input.first as usize, input.count() as usize);
-            let manifold: Vec<&PointConstraint> = points[first..first + count].iter().collect();
-            plan.fill_manifold(first, &manifold, &bodies);
+            plan.fill_manifold(first, &points[first..first + count], &bodies);
         }
         plan_one_island(&mut plan, &points, &bodies);
         assert_eq!(plan.items, kept);
