@@ -724,11 +724,11 @@ impl SoftStepSolver {
                 first.pair_coupling = Some(block);
                 input.add_second_point();
                 self.plan_inputs.push(input);
-                skipped |= self.place_manifold(k, &[first, q], small_island);
+                skipped |= self.place_manifold(k, [first, q], small_island);
                 k += 2;
             } else {
                 self.plan_inputs.push(input);
-                skipped |= self.place_manifold(k, &[first], small_island);
+                skipped |= self.place_manifold(k, [first], small_island);
                 carried = second;
                 k += 1;
             }
@@ -810,14 +810,21 @@ impl SoftStepSolver {
     /// or else written to the points. Returns whether it was left unwritten (see
     /// `build_points`); a small island's always is written, for the LCP.
     #[inline(always)]
-    fn place_manifold(&mut self, first: usize, manifold: &[PointConstraint], small: bool) -> bool {
-        let in_lane = self.plan.fill_manifold(first, manifold, &self.bodies);
+    fn place_manifold<const N: usize>(
+        &mut self,
+        first: usize,
+        manifold: [PointConstraint; N],
+        small: bool,
+    ) -> bool {
+        let in_lane = self.plan.fill_manifold(first, &manifold, &self.bodies);
         #[cfg(test)]
         let small = small || self.write_every_point;
         if in_lane && !small {
             return true;
         }
-        self.points[first..first + manifold.len()].copy_from_slice(manifold);
+        for (j, p) in manifold.into_iter().enumerate() {
+            self.points[first + j] = p;
+        }
         false
     }
 

@@ -408,10 +408,10 @@ impl PassPlan {
     /// The manifold of points `manifold` whose first point is `first`, just built, into
     /// the lane the kept plan has for it, if any and of its size: whether it went into one.
     #[inline(always)]
-    pub fn fill_manifold(
+    pub fn fill_manifold<const N: usize>(
         &mut self,
         first: usize,
-        manifold: &[PointConstraint],
+        manifold: &[PointConstraint; N],
         bodies: &[SoftBody],
     ) -> bool {
         if !self.filled_while_built {
@@ -421,7 +421,7 @@ impl PassPlan {
             return false;
         };
         let (two_points, batch, lane) = Slot::unpack(slot);
-        match (two_points, manifold.len()) {
+        match (two_points, N) {
             (true, 2) => self.pairs.batches[batch].fill_lane(lane, first as u32, manifold, bodies),
             (false, 1) => {
                 self.singles.batches[batch].fill_lane(lane, first as u32, manifold, bodies)
@@ -2074,7 +2074,10 @@ pub(super) mod tests {
         plan.begin_filling();
         for input in inputs_of(&points, &bodies) {
             let (first, count) = (input.first as usize, input.count() as usize);
-            plan.fill_manifold(first, &points[first..first + count], &bodies);
+            match count {
+                2 => plan.fill_manifold(first, &[points[first], points[first + 1]], &bodies),
+                _ => plan.fill_manifold(first, &[points[first]], &bodies),
+            };
         }
         plan_one_island(&mut plan, &points, &bodies);
         assert_eq!(plan.items, kept);
