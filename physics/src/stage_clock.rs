@@ -8,7 +8,7 @@
 //! change of a few percent needs (docs/bench/profile.md, "Cycles per stage").
 
 /// The stages a step is timed in. The soft step's three (preparing, warm start, solve)
-/// are timed under `ContactSolver::Soft` and `Auto` only.
+/// and preparing's parts are timed under `ContactSolver::Soft` and `Auto` only.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
     /// A whole `World::step`.
@@ -25,10 +25,18 @@ pub enum Stage {
     WarmStart,
     /// The soft step's passes with and without bias, positions integrated between them.
     Solve,
+    /// Within `Preparing`: the bodies copied in and the contacts grouped into islands.
+    PreparingIslands,
+    /// Within `Preparing`: the contacts' points built, and the kept plan's lanes filled
+    /// from them (`SoftStepSolver::build_points`, twice if the plan changed after all).
+    PreparingPoints,
+    /// Within `Preparing`: the small islands' LCPs set up, and the plan read and, if it
+    /// changed, made again (colours and batches).
+    PreparingPlan,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 7] = [
+    pub const ALL: [Stage; 10] = [
         Stage::Step,
         Stage::BroadPhase,
         Stage::NarrowPhase,
@@ -36,7 +44,20 @@ impl Stage {
         Stage::Preparing,
         Stage::WarmStart,
         Stage::Solve,
+        Stage::PreparingIslands,
+        Stage::PreparingPoints,
+        Stage::PreparingPlan,
     ];
+
+    /// The stage this one is a part of, if any (its cycles are counted in both).
+    pub fn within(self) -> Option<Stage> {
+        match self {
+            Stage::PreparingIslands | Stage::PreparingPoints | Stage::PreparingPlan => {
+                Some(Stage::Preparing)
+            }
+            _ => None,
+        }
+    }
 
     pub fn name(self) -> &'static str {
         match self {
@@ -47,6 +68,9 @@ impl Stage {
             Stage::Preparing => "preparing",
             Stage::WarmStart => "warm start",
             Stage::Solve => "solve",
+            Stage::PreparingIslands => "preparing: bodies, islands",
+            Stage::PreparingPoints => "preparing: points",
+            Stage::PreparingPlan => "preparing: LCPs, plan",
         }
     }
 }
@@ -145,7 +169,8 @@ mod tests {
     use crate::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
 
     /// A box resting on a floor under the soft step, three steps: three steps counted,
-    /// every stage took time, and the stages, which lie inside the step, add up to less.
+    /// every stage took time, the stages, which lie inside the step, add up to less, and
+    /// the parts of a stage to no more than it.
     #[test]
     fn each_step_counts_its_stages() {
         let mut w = World::new(Vec2::new(0.0, 10.0));
@@ -164,8 +189,13 @@ mod tests {
         assert_eq!(steps.len(), 3);
         for counts in steps {
             assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
-            let inside: u64 = counts[1..].iter().sum();
-            assert!(inside < counts[Stage::Step as usize], "{counts:?}");
+            let parts_of = |whole: Option<Stage>| -> u64 {
+                let parts = Stage::ALL[1..].iter().filter(|s| s.within() == whole);
+                parts.map(|&s| counts[s as usize]).sum()
+            };
+            assert!(parts_of(None) < counts[Stage::Step as usize], "{counts:?}");
+            let preparing = counts[Stage::Preparing as usize];
+            assert!(parts_of(Some(Stage::Preparing)) <= preparing, "{counts:?}");
         }
     }
 }

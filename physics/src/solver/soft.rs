@@ -532,6 +532,7 @@ impl SoftStepSolver {
         joints: &[JointConstraint],
         dt: f64,
     ) {
+        let started = stage_clock::mark();
         self.bodies.clear();
         self.bodies.extend(bodies.iter().map(|b| SoftBody {
             v: b.velocity,
@@ -555,16 +556,21 @@ impl SoftStepSolver {
             |i| self.bodies[i as usize].moves(),
         );
         island_ranges(grouped, &mut self.contact_islands);
+        stage_clock::record(Stage::PreparingIslands, started);
+        let started = stage_clock::mark();
         // Each manifold goes into the kept plan's lanes as soon as it is complete, and
         // then its points are not written: on a big pile at rest, writing them was a
         // tenth of the step (docs/bench/profile.md, "Points not written").
         self.plan.begin_filling();
         let skipped = self.build_points(bodies, accelerations, contacts, grouped, dt);
+        stage_clock::record(Stage::PreparingPoints, started);
+        let started = stage_clock::mark();
         self.contact_lcp
             .prepare(&self.bodies, &self.points, &self.contact_islands);
         let kept = self
             .plan
             .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+        stage_clock::record(Stage::PreparingPlan, started);
         let rebuild = skipped && (!kept || self.may_bounce);
         #[cfg(test)]
         {
@@ -576,11 +582,15 @@ impl SoftStepSolver {
             // point): every point is built again, and written. The LCP islands' points
             // were written already, and the plan's entries come out the same, so the LCP
             // and the plan's reading stand.
+            let rebuilt = stage_clock::mark();
             self.plan.stop_filling();
             self.build_points(bodies, accelerations, contacts, grouped, dt);
+            stage_clock::record(Stage::PreparingPoints, rebuilt);
         }
         self.contact_grouping = grouping;
+        let started = stage_clock::mark();
         self.plan.plan(&self.points, &self.bodies);
+        stage_clock::record(Stage::PreparingPlan, started);
         // Each pinned body's rotation once: a body of a net carries four pins.
         self.rotations.clear();
         if !joints.is_empty() {
