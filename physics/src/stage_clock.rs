@@ -25,6 +25,9 @@ pub enum Stage {
     WarmStart,
     /// The soft step's passes with and without bias, positions integrated between them.
     Solve,
+    /// The soft step's results written back: velocities and poses to the bodies, impulses
+    /// to the contacts and the warm-start memory.
+    Storing,
     /// Within `Preparing`: the bodies copied in and the contacts grouped into islands.
     PreparingIslands,
     /// Within `Preparing`: the contacts' points built, and the kept plan's lanes filled
@@ -36,7 +39,7 @@ pub enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 10] = [
+    pub const ALL: [Stage; 11] = [
         Stage::Step,
         Stage::BroadPhase,
         Stage::NarrowPhase,
@@ -44,6 +47,7 @@ impl Stage {
         Stage::Preparing,
         Stage::WarmStart,
         Stage::Solve,
+        Stage::Storing,
         Stage::PreparingIslands,
         Stage::PreparingPoints,
         Stage::PreparingPlan,
@@ -68,6 +72,7 @@ impl Stage {
             Stage::Preparing => "preparing",
             Stage::WarmStart => "warm start",
             Stage::Solve => "solve",
+            Stage::Storing => "storing",
             Stage::PreparingIslands => "preparing: bodies, islands",
             Stage::PreparingPoints => "preparing: points",
             Stage::PreparingPlan => "preparing: LCPs, plan",

@@ -12,6 +12,21 @@ pub struct ContactMemory {
 }
 
 impl ContactMemory {
+    /// Writes each contact's impulses from `impulses` (by contact, normal and tangent)
+    /// into it, and keeps them.
+    pub fn store_from(&mut self, contacts: &mut [Contact], impulses: &[(f64, f64)]) {
+        self.entries.clear();
+        self.entries.extend(
+            contacts
+                .iter_mut()
+                .zip(impulses)
+                .map(|(c, &(normal, tangent))| {
+                    (c.normal_impulse, c.tangent_impulse) = (normal, tangent);
+                    ((c.body_a, c.body_b, c.id.0), normal, tangent)
+                }),
+        );
+    }
+
     /// Keeps the impulses the solve wrote into `contacts`.
     pub fn store(&mut self, contacts: &[Contact]) {
         self.entries.clear();

@@ -24,7 +24,6 @@ use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, NormalBlock, PointConstraint, PointLevers, SoftBody, Softness};
 use crate::math::Vec2;
-use crate::solver::contact::Contact;
 use crate::solver::island::counting_sort;
 
 /// Colours of the constraint graph, as many as a body's `u32` of colour bits holds (a
@@ -471,13 +470,14 @@ impl PassPlan {
         }
     }
 
-    /// The batches' accumulated impulses, into their contacts.
-    pub fn store_impulses(&self, contacts: &mut [Contact]) {
+    /// The batches' accumulated impulses, into `impulses` (normal and tangent, by
+    /// contact).
+    pub fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
         for batch in self.batches() {
-            batch.store_impulses(contacts);
+            batch.store_impulses(impulses);
         }
         for batch in self.point_batches() {
-            batch.store_impulses(contacts);
+            batch.store_impulses(impulses);
         }
     }
 
@@ -1156,14 +1156,12 @@ impl<const N: usize> ManifoldBatch<N> {
         };
     }
 
-    /// The accumulated impulses, into the lanes' contacts.
-    pub(super) fn store_impulses(&self, contacts: &mut [Contact]) {
+    /// The accumulated impulses, into `impulses` at the lanes' contacts.
+    pub(super) fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
         let points = self.points.iter().zip(&self.normal_impulses);
         for ((lanes, normal), indices) in points.zip(&self.contacts) {
             for (k, &index) in indices.iter().enumerate().filter(|&(_, &i)| i != PAD) {
-                let c = &mut contacts[index as usize];
-                c.normal_impulse = normal.0[k];
-                c.tangent_impulse = lanes.tangent_impulse.0[k];
+                impulses[index as usize] = (normal.0[k], lanes.tangent_impulse.0[k]);
             }
         }
     }
@@ -1912,33 +1910,20 @@ pub(super) mod tests {
         let mut batch = ManifoldBatch::<2>::default();
         batch.fill(firsts, &points, &bodies);
         batch.solve_on(LanePath::best(), &mut bodies, &pass(true));
-        let contact = Contact {
-            body_a: 0,
-            body_b: 0,
-            point: Vec2::zeros(),
-            normal: Vec2::zeros(),
-            depth: 0.0,
-            id: crate::collide::FeatureId(0),
-            restitution: 0.0,
-            friction: 0.0,
-            approach_velocity: 0.0,
-            normal_velocity: 0.0,
-            normal_impulse: -1.0,
-            tangent_impulse: -1.0,
-        };
-        let (mut from_lanes, mut from_points) = (vec![contact; 16], vec![contact; 16]);
+        // Every contact's entry marked, so that an entry written by mistake shows.
+        let unwritten = (-1.0, -1.0);
+        let (mut from_lanes, mut from_points) = (vec![unwritten; 16], vec![unwritten; 16]);
         batch.store_impulses(&mut from_lanes);
         batch.scatter(&mut points);
         for p in &points[..10] {
-            let c = &mut from_points[p.contact as usize];
-            (c.normal_impulse, c.tangent_impulse) = (p.normal_impulse, p.tangent_impulse);
+            from_points[p.contact as usize] = (p.normal_impulse, p.tangent_impulse);
         }
         assert_eq!(from_lanes, from_points);
         // The unused lanes' points (10 to 15) are left alone.
         assert!(
             points[10..]
                 .iter()
-                .all(|p| from_lanes[p.contact as usize].normal_impulse == -1.0)
+                .all(|p| from_lanes[p.contact as usize] == unwritten)
         );
     }
 
