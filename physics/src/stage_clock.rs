@@ -7,8 +7,8 @@
 //! the fewest cycles a stage took over many steps of one run move by 1–2%, which is what a
 //! change of a few percent needs (docs/bench/profile.md, "Cycles per stage").
 
-/// The stages a step is timed in. The soft step's three (preparing, warm start, solve)
-/// and preparing's parts are timed under `ContactSolver::Soft` and `Auto` only.
+/// The stages a step is timed in. The soft step's (preparing and its parts, warm start,
+/// solve, storing) are timed under `ContactSolver::Soft` and `Auto` only.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {
     /// A whole `World::step`.

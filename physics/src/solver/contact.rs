@@ -22,7 +22,7 @@ impl ContactMemory {
                 .zip(impulses)
                 .map(|(c, &(normal, tangent))| {
                     (c.normal_impulse, c.tangent_impulse) = (normal, tangent);
-                    ((c.body_a, c.body_b, c.id.0), normal, tangent)
+                    (key(c), normal, tangent)
                 }),
         );
     }
@@ -30,10 +30,11 @@ impl ContactMemory {
     /// Keeps the impulses the solve wrote into `contacts`.
     pub fn store(&mut self, contacts: &[Contact]) {
         self.entries.clear();
-        self.entries.extend(contacts.iter().map(|c| {
-            let key = (c.body_a, c.body_b, c.id.0);
-            (key, c.normal_impulse, c.tangent_impulse)
-        }));
+        self.entries.extend(
+            contacts
+                .iter()
+                .map(|c| (key(c), c.normal_impulse, c.tangent_impulse)),
+        );
     }
 
     /// The last impulses of `contact`, the `k`-th of this step's contacts, if the `k`-th
@@ -41,7 +42,7 @@ impl ContactMemory {
     /// only that this guess missed (`recall` finds them all).
     #[inline]
     pub fn guess(&self, k: usize, contact: &Contact) -> Option<(f64, f64)> {
-        let key = (contact.body_a, contact.body_b, contact.id.0);
+        let key = key(contact);
         let m = self.entries.get(k)?;
         (m.0 == key).then_some((m.1, m.2))
     }
@@ -65,7 +66,7 @@ impl ContactMemory {
         let mut next = 0;
         let mut run: Option<((u32, u32), usize)> = None;
         out.extend(contacts.iter().map(|c| {
-            let key = (c.body_a, c.body_b, c.id.0);
+            let key = key(c);
             if let Some(m) = entries.get(next).filter(|m| m.0 == key) {
                 next += 1;
                 return (m.1, m.2);
@@ -111,6 +112,11 @@ impl ContactMemory {
 
 /// A remembered contact: ((body A, body B, feature), normal impulse, tangent impulse).
 type Entry = ((u32, u32, u32), f64, f64);
+
+/// What a contact is remembered by: its bodies and its feature.
+fn key(c: &Contact) -> (u32, u32, u32) {
+    (c.body_a, c.body_b, c.id.0)
+}
 
 /// One contact point between bodies `a` and `b`, with its material and its last impulses.
 #[derive(Debug, Clone, Copy, PartialEq)]
