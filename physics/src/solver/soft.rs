@@ -451,6 +451,25 @@ struct JointBlock {
     rhs: Vec<f64>,
 }
 
+/// The contacts' islands as `build_points` takes them: `(island, contact)` pairs
+/// (`IslandGrouping::grouped`), and, where they were taken unchecked, the bodies of the
+/// contacts they grouped, by contact (`IslandGrouping::ends`).
+type ContactGrouping<'a> = (&'a [(u32, u32)], Option<&'a [(u32, u32)]>);
+
+/// `build_points`' answer when a contact joins other bodies than the grouping it was
+/// given says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct ContactsRegrouped;
+
+/// What `build_points` carries from point to point as it reads the contacts.
+struct Reading<'a> {
+    recall: Recall,
+    /// The bodies of the contacts that the grouping taken unchecked grouped, by contact.
+    unchecked_ends: Option<&'a [(u32, u32)]>,
+    /// Whether a contact joins other bodies than those.
+    regrouped: bool,
+}
+
 /// How `build_points` finds the last step's impulses: guessing each contact's entry at
 /// its own index until a guess misses, then from all of them recalled at once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -553,21 +572,41 @@ impl SoftStepSolver {
         self.bodies.push(SoftBody::null());
         // The points are built island by island (each island's in the contacts' order):
         // grouping the contacts is cheaper than reordering the larger points afterwards.
+        // A pile at rest has the same contacts between the same bodies step after step:
+        // its last grouping is taken unchecked, and the points, which read every contact,
+        // check each one's bodies against it as they are built.
         let mut grouping = std::mem::take(&mut self.contact_grouping);
-        let grouped = grouping.group(
-            contacts.len(),
-            bodies.len(),
-            |i| (contacts[i].body_a, contacts[i].body_b),
-            |i| self.bodies[i as usize].moves(),
-        );
-        island_ranges(grouped, &mut self.contact_islands);
+        let reused = grouping.bodies_kept(contacts.len(), bodies.len(), |i| {
+            self.bodies[i as usize].moves()
+        });
+        if !reused {
+            self.group_contacts(&mut grouping, contacts);
+        }
         stage_clock::record(Stage::PreparingIslands, started);
         let started = stage_clock::mark();
         // Each manifold goes into the kept plan's lanes as soon as it is complete, and
         // then its points are not written: on a big pile at rest, writing them was a
         // tenth of the step (docs/bench/profile.md, "Points not written").
         self.plan.begin_filling();
-        let skipped = self.build_points(bodies, accelerations, contacts, grouped, dt);
+        let unchecked = reused.then(|| grouping.ends());
+        let built = self.build_points(
+            bodies,
+            accelerations,
+            contacts,
+            (grouping.grouped(), unchecked),
+            dt,
+        );
+        let skipped = match built {
+            Ok(skipped) => skipped,
+            Err(ContactsRegrouped) => {
+                // A contact joins other bodies than last step's: grouped afresh, and
+                // every point built again.
+                self.group_contacts(&mut grouping, contacts);
+                let grouped = (grouping.grouped(), None);
+                self.build_points(bodies, accelerations, contacts, grouped, dt)
+                    .expect("the contacts' own grouping")
+            }
+        };
         stage_clock::record(Stage::PreparingPoints, started);
         let started = stage_clock::mark();
         self.contact_lcp
@@ -589,7 +628,9 @@ impl SoftStepSolver {
             // and the plan's reading stand.
             let rebuilt = stage_clock::mark();
             self.plan.stop_filling();
-            self.build_points(bodies, accelerations, contacts, grouped, dt);
+            let grouped = (grouping.grouped(), None);
+            self.build_points(bodies, accelerations, contacts, grouped, dt)
+                .expect("the contacts' own grouping");
             stage_clock::record(Stage::PreparingPoints, rebuilt);
         }
         self.contact_grouping = grouping;
@@ -660,6 +701,17 @@ impl SoftStepSolver {
             .plan(&self.joints, &self.joint_islands, &self.bodies, unchanged);
     }
 
+    /// Groups the contacts by island afresh (`grouping`), and notes each island's range.
+    fn group_contacts(&mut self, grouping: &mut IslandGrouping, contacts: &[Contact]) {
+        let grouped = grouping.group(
+            contacts.len(),
+            self.bodies.len() - 1, // not the null body
+            |i| (contacts[i].body_a, contacts[i].body_b),
+            |i| self.bodies[i as usize].moves(),
+        );
+        island_ranges(grouped, &mut self.contact_islands);
+    }
+
     /// The contacts' points, in the order of `grouped` (island by island), their
     /// manifolds' entries for the plan (`plan_inputs`), and `may_bounce`. A manifold
     /// that goes into the kept plan's lanes (`PassPlan::fill_manifold`) is not written to
@@ -668,14 +720,18 @@ impl SoftStepSolver {
     /// was left so. Such entries are read only by a changed plan and where something may
     /// bounce (restitution, and the impulses stored from the points), and `prepare` then
     /// builds the points again, with the filling stopped.
+    ///
+    /// With `unchecked_ends` (the ends of the contacts that `grouped` grouped, by contact),
+    /// each contact's bodies are checked against them as its point is built, and one that
+    /// differs stops the building at its island's end: the grouping is not this step's.
     fn build_points(
         &mut self,
         bodies: &[SolverBody],
         accelerations: &[(Vec2, f64)],
         contacts: &[Contact],
-        grouped: &[(u32, u32)],
+        (grouped, unchecked_ends): ContactGrouping,
         dt: f64,
-    ) -> bool {
+    ) -> Result<bool, ContactsRegrouped> {
         if self.points.len() < contacts.len() {
             self.points
                 .resize(contacts.len(), PointConstraint::default());
@@ -683,7 +739,11 @@ impl SoftStepSolver {
         self.points.truncate(contacts.len());
         self.plan_inputs.clear();
         self.may_bounce = false;
-        let mut recall = Recall::Guessing;
+        let mut reading = Reading {
+            recall: Recall::Guessing,
+            unchecked_ends,
+            regrouped: false,
+        };
         let mut skipped = false;
         // A point built already that begins the next manifold: the second of two
         // whose block was not well conditioned.
@@ -694,6 +754,9 @@ impl SoftStepSolver {
         let mut k = 0;
         while k < grouped.len() {
             if k == island_end {
+                if reading.regrouped {
+                    return Err(ContactsRegrouped);
+                }
                 let (start, end) = self.contact_islands[island];
                 (island, island_end, small_island) =
                     (island + 1, end, end - start <= LCP_POINT_LIMIT);
@@ -707,7 +770,7 @@ impl SoftStepSolver {
                     contacts,
                     grouped[k].1,
                     dt,
-                    &mut recall,
+                    &mut reading,
                 ),
             };
             // The next contact is this manifold's second point if it joins the same
@@ -720,7 +783,7 @@ impl SoftStepSolver {
                     let d = &contacts[j as usize];
                     (d.body_a, d.body_b, d.normal) == (c.body_a, c.body_b, c.normal)
                 })
-                .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut recall));
+                .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut reading));
             let block = second.as_ref().and_then(|q| {
                 let pair = (
                     &self.bodies[c.body_a as usize],
@@ -748,7 +811,10 @@ impl SoftStepSolver {
                 k += 1;
             }
         }
-        skipped
+        if reading.regrouped {
+            return Err(ContactsRegrouped);
+        }
+        Ok(skipped)
     }
 
     /// The point of contact `i` (this step's contacts' index), its impulses recalled from
@@ -761,9 +827,14 @@ impl SoftStepSolver {
         contacts: &[Contact],
         i: u32,
         dt: f64,
-        recall: &mut Recall,
+        reading: &mut Reading,
     ) -> PointConstraint {
         let c = &contacts[i as usize];
+        if let Some(ends) = reading.unchecked_ends {
+            // Noted, not branched on: the building stops at the island's end.
+            reading.regrouped |= ends[i as usize] != (c.body_a, c.body_b);
+        }
+        let recall = &mut reading.recall;
         let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
         let r_a = c.point - a.position;
         let r_b = c.point - b.position;
@@ -1829,6 +1900,144 @@ impl ContactLcp {
                     pair.store(bodies);
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::FeatureId;
+
+    /// A unit box's two points on the body below it, `b` (the floor, or another box).
+    fn resting(a: u32, b: u32, x: f64, y: f64) -> [Contact; 2] {
+        let point = |dx: f64, id| Contact {
+            body_a: a,
+            body_b: b,
+            point: Vec2::new(x + dx, y),
+            normal: Vec2::new(0.0, -1.0),
+            depth: 0.004,
+            id: FeatureId(id),
+            restitution: 0.0,
+            friction: 0.6,
+            approach_velocity: 0.0,
+            normal_velocity: 0.0,
+            normal_impulse: 0.0,
+            tangent_impulse: 0.0,
+        };
+        [point(-0.5, 1), point(0.5, 2)]
+    }
+
+    /// A step whose contacts join other bodies than the last step's, as many of them and
+    /// with every body as free as before, takes the last grouping unchecked and must find
+    /// that out as it builds the points: it must move the bodies exactly as a solver that
+    /// grouped them afresh, and end with their grouping.
+    #[test]
+    fn contacts_on_other_bodies_are_grouped_again() {
+        // Six unit boxes in three columns on a fixed floor (7), x = 0, 2, 4.
+        let floor = SolverBody {
+            position: Vec2::new(0.0, 0.5),
+            ..SolverBody::default()
+        };
+        let boxes = [(0.0, 1), (0.0, 2), (0.0, 3), (2.0, 1), (2.0, 2), (4.0, 1)];
+        let mut bodies: Vec<SolverBody> = boxes
+            .iter()
+            .map(|&(x, row)| SolverBody {
+                position: Vec2::new(x, -(row as f64) + 0.5),
+                inv_mass: 1.0,
+                inv_inertia: 6.0,
+                ..SolverBody::default()
+            })
+            .collect();
+        bodies.push(floor);
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let stacked = |pairs: [(u32, u32, f64, f64); 6]| -> Vec<Contact> {
+            pairs
+                .into_iter()
+                .flat_map(|(a, b, x, y)| resting(a, b, x, y))
+                .collect()
+        };
+        let columns = stacked([
+            (0, 6, 0.0, 0.0),
+            (1, 0, 0.0, -1.0),
+            (2, 1, 0.0, -2.0),
+            (3, 6, 2.0, 0.0),
+            (4, 3, 2.0, -1.0),
+            (5, 6, 4.0, 0.0),
+        ]);
+        // Box 4 on box 5 instead of box 3: the last two islands change.
+        let mut moved = columns.clone();
+        for c in &mut moved[8..10] {
+            c.body_b = 5;
+        }
+        // Only a manifold's second point on another body (box 0 instead of box 1).
+        let mut second_moved = columns.clone();
+        second_moved[5].body_b = 0;
+        let settings = SoftSettings::for_length_scale(1.0);
+        let step = |solver: &mut SoftStepSolver, bodies: &mut Vec<SolverBody>, contacts| {
+            let mut contacts: Vec<Contact> = Vec::clone(contacts);
+            let h = 1.0 / 60.0;
+            solver.step(
+                &settings,
+                bodies,
+                &accelerations,
+                &mut contacts,
+                &mut [],
+                h,
+                1.0,
+            );
+            contacts
+        };
+        // Each step's contacts, whether the second step's grouping is the first's kept
+        // unchecked, and whether it is another.
+        let cases = [
+            (&columns, &columns, true, false),
+            (&columns, &moved, false, true),
+            (&columns, &second_moved, false, false), // the same islands
+            (&second_moved, &columns, false, false), // the second point joins the first
+        ];
+        for (first, second, kept, changes) in cases {
+            let (mut unchecked, mut fresh) = (SoftStepSolver::default(), SoftStepSolver::default());
+            let (mut bodies_unchecked, mut bodies_fresh) = (bodies.clone(), bodies.clone());
+            step(&mut unchecked, &mut bodies_unchecked, first);
+            step(&mut fresh, &mut bodies_fresh, first);
+            let first_grouping = unchecked.contact_grouping.grouped().to_vec();
+            fresh.contact_grouping = IslandGrouping::default();
+            let contacts_unchecked = step(&mut unchecked, &mut bodies_unchecked, second);
+            let contacts_fresh = step(&mut fresh, &mut bodies_fresh, second);
+            let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
+                let states = bodies.iter().flat_map(|b| {
+                    [
+                        b.velocity.x,
+                        b.velocity.y,
+                        b.angular_velocity,
+                        b.position.x,
+                        b.position.y,
+                        b.angle,
+                    ]
+                });
+                let impulses = contacts
+                    .iter()
+                    .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
+                states.chain(impulses).map(f64::to_bits).collect()
+            };
+            assert_eq!(
+                bits(&bodies_unchecked, &contacts_unchecked),
+                bits(&bodies_fresh, &contacts_fresh)
+            );
+            let grouping = unchecked.contact_grouping.grouped();
+            assert_eq!(grouping, fresh.contact_grouping.grouped());
+            assert_eq!(grouping != first_grouping, changes);
+            assert_eq!(unchecked.contact_grouping.kept(), kept);
+            // Every manifold pushed: the step solved what it was given.
+            let pushes = contacts_unchecked
+                .chunks(2)
+                .map(|m| m[0].normal_impulse + m[1].normal_impulse);
+            assert!(
+                pushes.clone().all(|p| p > 0.0),
+                "{:?}",
+                pushes.collect::<Vec<_>>()
+            );
         }
     }
 }
