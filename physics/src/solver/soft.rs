@@ -1909,118 +1909,128 @@ mod tests {
     use super::*;
     use crate::collide::FeatureId;
 
-    /// A unit box's two points on the body below it, `b` (the floor, or another box).
-    fn resting(a: u32, b: u32, x: f64, y: f64) -> [Contact; 2] {
-        let point = |dx: f64, id| Contact {
-            body_a: a,
-            body_b: b,
-            point: Vec2::new(x + dx, y),
-            normal: Vec2::new(0.0, -1.0),
-            depth: 0.004,
-            id: FeatureId(id),
-            restitution: 0.0,
-            friction: 0.6,
-            approach_velocity: 0.0,
-            normal_velocity: 0.0,
-            normal_impulse: 0.0,
-            tangent_impulse: 0.0,
-        };
-        [point(-0.5, 1), point(0.5, 2)]
+    /// Boxes in columns on a fixed floor (the last body), and each box's two points on
+    /// the body below it: the columns' heights, their boxes numbered from the first
+    /// column's bottom up.
+    fn columns(heights: &[usize]) -> (Vec<SolverBody>, Vec<Contact>) {
+        let count: usize = heights.iter().sum();
+        let floor = count as u32;
+        let (mut bodies, mut contacts) = (vec![], vec![]);
+        for (column, &height) in heights.iter().enumerate() {
+            let x = 3.0 * column as f64;
+            for row in 0..height {
+                let below = if row == 0 {
+                    floor
+                } else {
+                    bodies.len() as u32 - 1
+                };
+                let y = -(row as f64);
+                for (dx, id) in [(-0.5, 1), (0.5, 2)] {
+                    contacts.push(Contact {
+                        body_a: bodies.len() as u32,
+                        body_b: below,
+                        point: Vec2::new(x + dx, y),
+                        normal: Vec2::new(0.0, -1.0),
+                        depth: 0.004,
+                        id: FeatureId(id),
+                        restitution: 0.0,
+                        friction: 0.6,
+                        approach_velocity: 0.0,
+                        normal_velocity: 0.0,
+                        normal_impulse: 0.0,
+                        tangent_impulse: 0.0,
+                    });
+                }
+                bodies.push(SolverBody {
+                    position: Vec2::new(x, y - 0.5),
+                    inv_mass: 1.0,
+                    inv_inertia: 6.0,
+                    ..SolverBody::default()
+                });
+            }
+        }
+        bodies.push(SolverBody::default());
+        (bodies, contacts)
     }
 
     /// A step whose contacts join other bodies than the last step's, as many of them and
     /// with every body as free as before, takes the last grouping unchecked and must find
-    /// that out as it builds the points: it must move the bodies exactly as a solver that
-    /// grouped them afresh, and end with their grouping.
+    /// that out as it builds the points (some of them into the kept plan's lanes): it must
+    /// move the bodies exactly as a solver that grouped them afresh, and end with their
+    /// grouping.
     #[test]
     fn contacts_on_other_bodies_are_grouped_again() {
-        // Six unit boxes in three columns on a fixed floor (7), x = 0, 2, 4.
-        let floor = SolverBody {
-            position: Vec2::new(0.0, 0.5),
-            ..SolverBody::default()
-        };
-        let boxes = [(0.0, 1), (0.0, 2), (0.0, 3), (2.0, 1), (2.0, 2), (4.0, 1)];
-        let mut bodies: Vec<SolverBody> = boxes
-            .iter()
-            .map(|&(x, row)| SolverBody {
-                position: Vec2::new(x, -(row as f64) + 0.5),
-                inv_mass: 1.0,
-                inv_inertia: 6.0,
-                ..SolverBody::default()
-            })
-            .collect();
-        bodies.push(floor);
+        // A column of 30 boxes (60 points: coloured into batches), one of 10 (20 points:
+        // solved point by point) and a box alone (an LCP island).
+        let (bodies, standing) = columns(&[30, 10, 1]);
         let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
-        let stacked = |pairs: [(u32, u32, f64, f64); 6]| -> Vec<Contact> {
-            pairs
-                .into_iter()
-                .flat_map(|(a, b, x, y)| resting(a, b, x, y))
-                .collect()
-        };
-        let columns = stacked([
-            (0, 6, 0.0, 0.0),
-            (1, 0, 0.0, -1.0),
-            (2, 1, 0.0, -2.0),
-            (3, 6, 2.0, 0.0),
-            (4, 3, 2.0, -1.0),
-            (5, 6, 4.0, 0.0),
-        ]);
-        // Box 4 on box 5 instead of box 3: the last two islands change.
-        let mut moved = columns.clone();
-        for c in &mut moved[8..10] {
-            c.body_b = 5;
+        // Box 35 on box 20 instead of box 34: the two columns' islands change.
+        let mut moved = standing.clone();
+        for c in &mut moved[70..72] {
+            c.body_b = 20;
         }
-        // Only a manifold's second point on another body (box 0 instead of box 1).
-        let mut second_moved = columns.clone();
-        second_moved[5].body_b = 0;
+        // The box alone on box 39 instead of the floor: the last island (in the grouping
+        // taken unchecked) joins another.
+        let mut last_moved = standing.clone();
+        for c in &mut last_moved[80..82] {
+            c.body_b = 39;
+        }
+        // Only a manifold's second point on another body (box 8 instead of box 9), in
+        // the same island.
+        let mut second_moved = standing.clone();
+        second_moved[21].body_b = 8;
         let settings = SoftSettings::for_length_scale(1.0);
         let step = |solver: &mut SoftStepSolver, bodies: &mut Vec<SolverBody>, contacts| {
             let mut contacts: Vec<Contact> = Vec::clone(contacts);
             let h = 1.0 / 60.0;
+            let mut joints = [];
             solver.step(
                 &settings,
                 bodies,
                 &accelerations,
                 &mut contacts,
-                &mut [],
+                &mut joints,
                 h,
                 1.0,
             );
             contacts
         };
-        // Each step's contacts, whether the second step's grouping is the first's kept
-        // unchecked, and whether it is another.
+        let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
+            let states = bodies.iter().flat_map(|b| {
+                let (v, p) = (b.velocity, b.position);
+                [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
+            });
+            let impulses = contacts
+                .iter()
+                .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
+            states.chain(impulses).map(f64::to_bits).collect()
+        };
+        // The first steps' contacts and the last step's, whether the last step's grouping
+        // is the first steps' kept unchecked, and whether it is another.
         let cases = [
-            (&columns, &columns, true, false),
-            (&columns, &moved, false, true),
-            (&columns, &second_moved, false, false), // the same islands
-            (&second_moved, &columns, false, false), // the second point joins the first
+            (&standing, &standing, true, false),
+            (&standing, &moved, false, true),
+            (&standing, &last_moved, false, true),
+            (&standing, &second_moved, false, false), // the same islands
+            (&second_moved, &standing, false, false), // the second point joins the first
         ];
-        for (first, second, kept, changes) in cases {
+        for (first, last, kept, changes) in cases {
             let (mut unchecked, mut fresh) = (SoftStepSolver::default(), SoftStepSolver::default());
             let (mut bodies_unchecked, mut bodies_fresh) = (bodies.clone(), bodies.clone());
-            step(&mut unchecked, &mut bodies_unchecked, first);
-            step(&mut fresh, &mut bodies_fresh, first);
+            // Steps enough for the plan to be kept, and its lanes filled as the points
+            // are built.
+            for _ in 0..4 {
+                step(&mut unchecked, &mut bodies_unchecked, first);
+                step(&mut fresh, &mut bodies_fresh, first);
+            }
+            assert!(
+                unchecked.steps_skipping.0 > 0,
+                "no lane was filled unwritten"
+            );
             let first_grouping = unchecked.contact_grouping.grouped().to_vec();
             fresh.contact_grouping = IslandGrouping::default();
-            let contacts_unchecked = step(&mut unchecked, &mut bodies_unchecked, second);
-            let contacts_fresh = step(&mut fresh, &mut bodies_fresh, second);
-            let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
-                let states = bodies.iter().flat_map(|b| {
-                    [
-                        b.velocity.x,
-                        b.velocity.y,
-                        b.angular_velocity,
-                        b.position.x,
-                        b.position.y,
-                        b.angle,
-                    ]
-                });
-                let impulses = contacts
-                    .iter()
-                    .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
-                states.chain(impulses).map(f64::to_bits).collect()
-            };
+            let contacts_unchecked = step(&mut unchecked, &mut bodies_unchecked, last);
+            let contacts_fresh = step(&mut fresh, &mut bodies_fresh, last);
             assert_eq!(
                 bits(&bodies_unchecked, &contacts_unchecked),
                 bits(&bodies_fresh, &contacts_fresh)
@@ -2029,8 +2039,8 @@ mod tests {
             assert_eq!(grouping, fresh.contact_grouping.grouped());
             assert_eq!(grouping != first_grouping, changes);
             assert_eq!(unchecked.contact_grouping.kept(), kept);
-            // Every manifold pushed: the step solved what it was given.
-            let pushes = contacts_unchecked
+            // The tall column's every box pushed: the step solved what it was given.
+            let pushes = contacts_unchecked[..60]
                 .chunks(2)
                 .map(|m| m[0].normal_impulse + m[1].normal_impulse);
             assert!(
