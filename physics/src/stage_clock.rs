@@ -28,10 +28,13 @@ pub enum Stage {
     /// The soft step's results written back: velocities and poses to the bodies, impulses
     /// to the contacts and the warm-start memory.
     Storing,
-    /// Within `Preparing`: the bodies copied in and the contacts grouped into islands.
+    /// Within `Preparing`: the bodies copied in and the contacts grouped into islands (on
+    /// a pile at rest, only the bodies' freedom checked: the last grouping is taken, and
+    /// the contacts' bodies are checked as their points are built).
     PreparingIslands,
     /// Within `Preparing`: the contacts' points built, and the kept plan's lanes filled
-    /// from them (`SoftStepSolver::build_points`, twice if the plan changed after all).
+    /// from them (`SoftStepSolver::build_points`, twice if the plan changed after all or
+    /// the contacts' grouping taken unchecked was not theirs).
     PreparingPoints,
     /// Within `Preparing`: the small islands' LCPs set up, and the plan read and, if it
     /// changed, made again (colours and batches).
