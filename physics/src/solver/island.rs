@@ -116,8 +116,7 @@ impl IslandGrouping {
         // Items first: a step that changes anything usually changes them early.
         let same = self.ends.len() == count
             && (0..count).all(|i| self.ends[i] == ends(i))
-            && self.dynamic.len() == bodies
-            && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32));
+            && self.dynamic_unchanged(bodies, &dynamic);
         self.kept = same;
         if !same {
             self.dynamic.clear();
@@ -150,11 +149,14 @@ impl IslandGrouping {
         bodies: usize,
         dynamic: impl Fn(u32) -> bool,
     ) -> bool {
-        let same = self.ends.len() == count
-            && self.dynamic.len() == bodies
-            && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32));
+        let same = self.ends.len() == count && self.dynamic_unchanged(bodies, &dynamic);
         self.kept = same;
         same
+    }
+
+    /// Whether there are `bodies` bodies again, each `dynamic` as at the last call.
+    fn dynamic_unchanged(&self, bodies: usize, dynamic: &impl Fn(u32) -> bool) -> bool {
+        self.dynamic.len() == bodies && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32))
     }
 
     /// The last call's result: `(island key, item)` pairs, as `group` returned them.
