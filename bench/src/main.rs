@@ -114,13 +114,14 @@ fn main() {
     }
     let docs = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/bench");
     let load = load_average();
+    let code = code_version();
     harness::pin_to_the_benchmark_core();
     let started = Instant::now();
     if std::env::args().nth(1).as_deref() == Some("sweep") {
         let mut md = sweep::run(docs);
         let _ = writeln!(
             md,
-            "Machine: {}; load average at start: {load}; {}; whole sweep {:.0} s. \
+            "Machine: {}; load average at start: {load}; {}; {code}; whole sweep {:.0} s. \
              rapier2d: {}; Box2D v3: {}; every engine compiled for this processor.",
             machine(),
             today(),
@@ -209,7 +210,7 @@ fn main() {
         &robot_rows,
         &throw_rows,
         started.elapsed(),
-        &load,
+        (&load, &code),
     );
     write_doc(docs, "results.md", &report);
 }
@@ -520,7 +521,7 @@ fn report(
     robot_rows: &[robots::RobotRow],
     throw_rows: &[throws::ThrowsRow],
     elapsed: Duration,
-    load: &str,
+    (load, code): (&str, &str),
 ) -> String {
     let names: Vec<&str> = PE_SOLVERS.iter().map(|s| s.name()).collect();
     let mut md = String::new();
@@ -528,7 +529,7 @@ fn report(
     // Writing to a String cannot fail.
     let _ = writeln!(w, "# pe vs rapier2d and Box2D v3\n");
     let _ = writeln!(w, "- Machine: {}; load average at start: {load}", machine());
-    let _ = writeln!(w, "- Date: {} (UTC)", today());
+    let _ = writeln!(w, "- Date: {} (UTC); {code}", today());
     let _ = writeln!(
         w,
         "- Engines: pe (this repository, f64) with contact solvers `{}`; rapier2d {} \
@@ -794,6 +795,38 @@ fn load_average() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+/// The code measured: the repository's commit, and whether pe's or the bench's sources
+/// differ from it (a run of work in progress), from `git` at the start of the run.
+fn code_version() -> String {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let git = |args: &[&str]| {
+        let out = std::process::Command::new("git")
+            .arg("-C")
+            .arg(root)
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())?;
+        String::from_utf8(out.stdout).ok()
+    };
+    let Some(commit) = git(&["rev-parse", "--short", "HEAD"]) else {
+        return "code: unknown (no git repository)".into();
+    };
+    let sources = [
+        "physics",
+        "bench/src",
+        "bench/Cargo.toml",
+        "bench/Cargo.lock",
+    ];
+    let status = git(&[&["status", "--porcelain", "--"][..], &sources[..]].concat());
+    let changed = match status.as_deref() {
+        Some("") => "",
+        Some(_) => ", with uncommitted changes to pe or the bench",
+        None => ", changes unknown",
+    };
+    format!("code of commit {}{changed}", commit.trim())
+}
+
 /// CPU model and logical core count, from /proc/cpuinfo (Linux).
 fn machine() -> String {
     let Ok(info) = std::fs::read_to_string("/proc/cpuinfo") else {
@@ -900,6 +933,24 @@ fn civil_from_days(days: i64) -> (i64, u32, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bench runs from its repository: results.md names the commit it measured, and
+    /// says so when pe's or the bench's sources differ from it.
+    #[test]
+    fn the_code_measured_is_named_by_its_commit() {
+        let code = code_version();
+        let commit = code.strip_prefix("code of commit ").expect(&code);
+        let hash = commit.split(',').next().unwrap();
+        assert!(
+            hash.len() >= 7 && hash.chars().all(|c| c.is_ascii_hexdigit()),
+            "{code}"
+        );
+        let rest = &commit[hash.len()..];
+        assert!(
+            ["", ", with uncommitted changes to pe or the bench"].contains(&rest),
+            "{code}"
+        );
+    }
 
     #[test]
     fn table_heads_align_the_lead_left() {
