@@ -234,10 +234,18 @@ impl NormalBlock {
     /// The block of two points `p`, `q` of one manifold between bodies `a` and `b`, if it
     /// is well conditioned.
     fn of(
-        (a, b): (&SoftBody, &SoftBody),
+        pair: (&SoftBody, &SoftBody),
         (p, q): (&PointConstraint, &PointConstraint),
     ) -> Option<Self> {
-        let (l1, l2) = (p.levers.normal, q.levers.normal);
+        Self::of_levers(pair, (p.levers.normal, q.levers.normal))
+    }
+
+    /// `of` for two points whose normal levers (`PointLevers::normal`) are `l1` and `l2`.
+    #[inline(always)]
+    fn of_levers(
+        (a, b): (&SoftBody, &SoftBody),
+        (l1, l2): ((f64, f64), (f64, f64)),
+    ) -> Option<Self> {
         // Multiplied out again rather than taken as 1 / normal_mass, and the inverse
         // from one reciprocal: divisions were the slowest part of building the points.
         let m = a.inv_mass + b.inv_mass;
@@ -267,6 +275,18 @@ struct PointLevers {
 }
 
 impl PointLevers {
+    /// The levers of contact `c` about its bodies' centroids at the step's start.
+    #[inline(always)]
+    fn of(bodies: &[SolverBody], c: &Contact) -> Self {
+        let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+        let r_a = c.point - a.position;
+        let r_b = c.point - b.position;
+        Self {
+            normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
+            reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
+        }
+    }
+
     /// The tangent row's lever arms, r × t with t = perp(n): the reach, r · n.
     fn tangent(&self) -> (f64, f64) {
         self.reach
@@ -395,6 +415,9 @@ pub struct SoftStepSolver {
     /// from: each manifold's entry, noted as its points are built.
     plan: PassPlan,
     plan_inputs: Vec<PlanInput>,
+    /// The entries a plan made before the points were built was made from
+    /// (`plan_from_contacts`).
+    planned_inputs: Vec<PlanInput>,
     /// Whether any point has restitution: a pile has none, and skips the pass over its
     /// points that looks for bounces.
     may_bounce: bool,
@@ -409,6 +432,9 @@ pub struct SoftStepSolver {
     /// Tests only: steps that left points unwritten, and steps that built them again.
     #[cfg(test)]
     pub(crate) steps_skipping: (usize, usize),
+    /// Tests only: steps that made their plan before their points.
+    #[cfg(test)]
+    pub(crate) steps_planned_first: usize,
 }
 
 /// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
@@ -455,6 +481,17 @@ struct JointBlock {
 /// (`IslandGrouping::grouped`), and, where they were taken unchecked, the bodies of the
 /// contacts they grouped, by contact (`IslandGrouping::ends`).
 type ContactGrouping<'a> = (&'a [(u32, u32)], Option<&'a [(u32, u32)]>);
+
+/// The contact after the `k`-th of `grouped`, if it is the same manifold's second point:
+/// it joins the same bodies along the same normal. (A manifold's points share their
+/// bodies, so their island.)
+fn second_point_of(contacts: &[Contact], grouped: &[(u32, u32)], k: usize) -> Option<u32> {
+    let c = &contacts[grouped[k].1 as usize];
+    grouped.get(k + 1).map(|&(_, j)| j).filter(|&j| {
+        let d = &contacts[j as usize];
+        (d.body_a, d.body_b, d.normal) == (c.body_a, c.body_b, c.normal)
+    })
+}
 
 /// `build_points`' answer when a contact joins other bodies than the grouping it was
 /// given says.
@@ -583,11 +620,28 @@ impl SoftStepSolver {
             self.group_contacts(&mut grouping, contacts);
         }
         stage_clock::record(Stage::PreparingIslands, started);
+        // After a step whose plan changed (debris in flight: every step of the smash), the
+        // plan is made from the contacts before the points are built, so that each
+        // manifold goes straight into its lane, rather than into the points and from
+        // there, read in colour order, into its lane (docs/bench/profile.md, "The plan
+        // made before the points").
+        let started = stage_clock::mark();
+        #[cfg(not(test))]
+        let may_plan_first = !reused && !self.plan.kept_last_step();
+        #[cfg(test)]
+        let may_plan_first = !reused && !self.plan.kept_last_step() && !self.write_every_point;
+        let planned_first =
+            may_plan_first && self.plan_from_contacts(bodies, contacts, grouping.grouped());
+        if planned_first {
+            stage_clock::record(Stage::PreparingPlan, started);
+        }
         let started = stage_clock::mark();
         // Each manifold goes into the kept plan's lanes as soon as it is complete, and
         // then its points are not written: on a big pile at rest, writing them was a
         // tenth of the step (docs/bench/profile.md, "Points not written").
-        self.plan.begin_filling();
+        if !planned_first {
+            self.plan.begin_filling();
+        }
         let unchecked = reused.then(|| grouping.ends());
         let built = self.build_points(
             bodies,
@@ -611,15 +665,23 @@ impl SoftStepSolver {
         let started = stage_clock::mark();
         self.contact_lcp
             .prepare(&self.bodies, &self.points, &self.contact_islands);
-        let kept = self
-            .plan
-            .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+        // The plan was made from the manifolds the points make (the same pairing, from
+        // the same levers), and nothing bounces: it stands, its lanes filled.
+        debug_assert!(!planned_first || self.plan_inputs == self.planned_inputs);
+        if planned_first {
+            self.plan.stop_filling();
+        }
+        let kept = planned_first
+            || self
+                .plan
+                .read(&self.contact_lcp.all_islands, &self.plan_inputs);
         stage_clock::record(Stage::PreparingPlan, started);
-        let rebuild = skipped && (!kept || self.may_bounce);
+        let rebuild = skipped && !planned_first && (!kept || self.may_bounce);
         #[cfg(test)]
         {
             self.steps_skipping.0 += usize::from(skipped);
             self.steps_skipping.1 += usize::from(rebuild);
+            self.steps_planned_first += usize::from(planned_first);
         }
         if rebuild {
             // The plan changed after all, or something bounces (restitution reads every
@@ -634,9 +696,11 @@ impl SoftStepSolver {
             stage_clock::record(Stage::PreparingPoints, rebuilt);
         }
         self.contact_grouping = grouping;
-        let started = stage_clock::mark();
-        self.plan.plan(&self.points, &self.bodies);
-        stage_clock::record(Stage::PreparingPlan, started);
+        if !planned_first {
+            let started = stage_clock::mark();
+            self.plan.plan(&self.points, &self.bodies);
+            stage_clock::record(Stage::PreparingPlan, started);
+        }
         // Each pinned body's rotation once: a body of a net carries four pins.
         self.rotations.clear();
         if !joints.is_empty() {
@@ -699,6 +763,65 @@ impl SoftStepSolver {
         let unchanged = self.joint_grouping.kept();
         self.pin_plan
             .plan(&self.joints, &self.joint_islands, &self.bodies, unchanged);
+    }
+
+    /// Plans the passes before the points are built (`PassPlan::plan_before_points`),
+    /// from the manifolds' entries read off the contacts in the order of `grouped`, as
+    /// `build_points` notes them: a contact and the next are one manifold if they join
+    /// the same bodies along the same normal and their 2 × 2 block is well conditioned
+    /// (found from their levers alone). Kept in `planned_inputs`, which the points'
+    /// entries must equal. Not if a contact may bounce (restitution reads every point, so
+    /// they are written anyway): then false, and nothing is planned.
+    fn plan_from_contacts(
+        &mut self,
+        bodies: &[SolverBody],
+        contacts: &[Contact],
+        grouped: &[(u32, u32)],
+    ) -> bool {
+        self.planned_inputs.clear();
+        let mut k = 0;
+        while k < grouped.len() {
+            let c = &contacts[grouped[k].1 as usize];
+            if c.restitution != 0.0 {
+                return false;
+            }
+            let moves = |i: u32| self.bodies[i as usize].moves();
+            let mut input = PlanInput::new(
+                (c.body_a, c.body_b),
+                k,
+                (moves(c.body_a), moves(c.body_b)),
+                c.normal,
+            );
+            // A second point joins the first's bodies, so it has the first's restitution.
+            let coupled = second_point_of(contacts, grouped, k).is_some_and(|j| {
+                let pair = (
+                    &self.bodies[c.body_a as usize],
+                    &self.bodies[c.body_b as usize],
+                );
+                let (p, q) = (
+                    PointLevers::of(bodies, c),
+                    PointLevers::of(bodies, &contacts[j as usize]),
+                );
+                NormalBlock::of_levers(pair, (p.normal, q.normal)).is_some()
+            });
+            if coupled {
+                input.add_second_point();
+                k += 2;
+            } else {
+                k += 1;
+            }
+            self.planned_inputs.push(input);
+        }
+        let ends = |k: usize| {
+            let c = &contacts[grouped[k].1 as usize];
+            (c.body_a, c.body_b)
+        };
+        self.contact_lcp
+            .classify(&self.bodies, &self.contact_islands, ends);
+        self.plan
+            .read(&self.contact_lcp.all_islands, &self.planned_inputs);
+        self.plan.plan_before_points(contacts.len(), &self.bodies);
+        true
     }
 
     /// Groups the contacts by island afresh (`grouping`), and notes each island's range.
@@ -773,16 +896,8 @@ impl SoftStepSolver {
                     &mut reading,
                 ),
             };
-            // The next contact is this manifold's second point if it joins the same
-            // bodies along the same normal; the two are coupled if their block is well
-            // conditioned. (A manifold's points share their bodies, so their island.)
-            let second = grouped
-                .get(k + 1)
-                .map(|&(_, j)| j)
-                .filter(|&j| {
-                    let d = &contacts[j as usize];
-                    (d.body_a, d.body_b, d.normal) == (c.body_a, c.body_b, c.normal)
-                })
+            // The two are coupled if their block is well conditioned.
+            let second = second_point_of(contacts, grouped, k)
                 .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut reading));
             let block = second.as_ref().and_then(|q| {
                 let pair = (
@@ -836,12 +951,7 @@ impl SoftStepSolver {
         }
         let recall = &mut reading.recall;
         let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-        let r_a = c.point - a.position;
-        let r_b = c.point - b.position;
-        let levers = PointLevers {
-            normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-            reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
-        };
+        let levers = PointLevers::of(bodies, c);
         // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
         let mass = |levers: (f64, f64)| {
             let inertias = (a.inv_inertia, b.inv_inertia);
@@ -1765,19 +1875,8 @@ impl ContactLcp {
         self.all_islands.clear();
         self.k.clear();
         for &(start, end) in islands {
-            let len = end - start;
-            let (lightest, heaviest) = if len <= LCP_POINT_LIMIT {
-                points[start..end]
-                    .iter()
-                    .flat_map(|p| [p.a, p.b])
-                    .map(|i| bodies[i as usize].inv_mass)
-                    .filter(|&m| m > 0.0)
-                    .fold((0.0, f64::INFINITY), |(most, least), m| {
-                        (f64::max(most, m), f64::min(least, m))
-                    })
-            } else {
-                (0.0, f64::INFINITY)
-            };
+            let ends = points[start..end].iter().map(|p| (p.a, p.b));
+            let (lightest, heaviest) = Self::inverse_mass_range(bodies, end - start, ends);
             let lcp = lightest >= LCP_NORMALS_MASS_RATIO * heaviest;
             self.all_islands.push((start, end, lcp));
             if lcp {
@@ -1819,6 +1918,42 @@ impl ContactLcp {
             self.solvers
                 .resize_with(self.islands.len(), LcpSolver::default);
         }
+    }
+
+    /// Which of `islands` `prepare` makes an LCP of, into `all_islands`, from the bodies
+    /// of each point (`ends`, by index) before the points are built.
+    fn classify(
+        &mut self,
+        bodies: &[SoftBody],
+        islands: &[(usize, usize)],
+        ends: impl Fn(usize) -> (u32, u32),
+    ) {
+        self.all_islands.clear();
+        for &(start, end) in islands {
+            let island_ends = (start..end).map(&ends);
+            let (lightest, heaviest) = Self::inverse_mass_range(bodies, end - start, island_ends);
+            let lcp = lightest >= LCP_NORMALS_MASS_RATIO * heaviest;
+            self.all_islands.push((start, end, lcp));
+        }
+    }
+
+    /// The largest and the smallest inverse mass of the moving bodies of an island of
+    /// `len` points (their bodies `ends`), if it is small enough to be an LCP; else a
+    /// range no LCP is made of.
+    fn inverse_mass_range(
+        bodies: &[SoftBody],
+        len: usize,
+        ends: impl Iterator<Item = (u32, u32)>,
+    ) -> (f64, f64) {
+        if len > LCP_POINT_LIMIT {
+            return (0.0, f64::INFINITY);
+        }
+        ends.flat_map(|(a, b)| [a, b])
+            .map(|i| bodies[i as usize].inv_mass)
+            .filter(|&m| m > 0.0)
+            .fold((0.0, f64::INFINITY), |(most, least), m| {
+                (f64::max(most, m), f64::min(least, m))
+            })
     }
 
     /// One pass over the small islands: totals x with w = K (x − x₀) + v − target, normals
@@ -1951,6 +2086,72 @@ mod tests {
         }
         bodies.push(SolverBody::default());
         (bodies, contacts)
+    }
+
+    /// After a step whose plan changed, the next plan is made from the contacts before the
+    /// points are built, and each manifold goes straight into its lane. That must solve
+    /// exactly as a solver that writes every point first and plans from them, through
+    /// steps whose coloured island changes every time, with a manifold whose two points
+    /// lie on one spot (its 2 × 2 block singular: two one-point manifolds) in it.
+    #[test]
+    fn a_plan_made_before_the_points_solves_as_one_made_after() {
+        let (bodies, mut whole) = columns(&[30, 10, 1]);
+        // Box 12's two points (contacts 24 and 25) on one spot.
+        whole[25].point = whole[24].point;
+        // Without the tall column's top box's contacts: the coloured island's plan
+        // changes at every step.
+        let mut topless = whole.clone();
+        topless.drain(58..60);
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let step = |solver: &mut SoftStepSolver, bodies: &mut Vec<SolverBody>, contacts| {
+            let mut contacts: Vec<Contact> = Vec::clone(contacts);
+            let mut joints = [];
+            let h = 1.0 / 60.0;
+            solver.step(
+                &settings,
+                bodies,
+                &accelerations,
+                &mut contacts,
+                &mut joints,
+                h,
+                1.0,
+            );
+            contacts
+        };
+        let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
+            let states = bodies.iter().flat_map(|b| {
+                let (v, p) = (b.velocity, b.position);
+                [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
+            });
+            let impulses = contacts
+                .iter()
+                .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
+            states.chain(impulses).map(f64::to_bits).collect()
+        };
+        let mut first = SoftStepSolver::default();
+        let mut after = SoftStepSolver {
+            write_every_point: true,
+            ..SoftStepSolver::default()
+        };
+        let (mut bodies_first, mut bodies_after) = (bodies.clone(), bodies);
+        for k in 0..8 {
+            let contacts = if k % 2 == 0 { &whole } else { &topless };
+            let contacts_first = step(&mut first, &mut bodies_first, contacts);
+            let contacts_after = step(&mut after, &mut bodies_after, contacts);
+            assert_eq!(
+                bits(&bodies_first, &contacts_first),
+                bits(&bodies_after, &contacts_after),
+                "step {k}"
+            );
+        }
+        // Every step: each changes the plan (the first makes one).
+        assert_eq!(first.steps_planned_first, 8);
+        assert_eq!(after.steps_planned_first, 0);
+        // The singular manifold went as two one-point manifolds.
+        let around = first.plan_inputs.iter().map(|p| p.first_and_count());
+        let around: Vec<_> = around.filter(|&(k, _)| (22..28).contains(&k)).collect();
+        assert_eq!(around, [(22, 2), (24, 1), (25, 1), (26, 2)]);
     }
 
     /// A step whose contacts join other bodies than the last step's, as many of them and

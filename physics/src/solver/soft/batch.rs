@@ -266,6 +266,12 @@ impl PlanInput {
         self.flags |= Self::TWO_POINTS;
     }
 
+    /// Tests only: the manifold's first point and its count of points.
+    #[cfg(test)]
+    pub fn first_and_count(self) -> (u32, u32) {
+        (self.first, self.count())
+    }
+
     fn count(self) -> u32 {
         if self.flags & Self::TWO_POINTS != 0 {
             2
@@ -292,14 +298,42 @@ impl PassPlan {
             // A pile at rest: the same manifolds between the same bodies.
             if !filled_while_built {
                 for batch in self.pairs.filled_mut() {
-                    batch.fill(batch.first_point, points, bodies);
+                    batch.fill(batch.first_point, Some(points), bodies);
                 }
                 for batch in self.singles.filled_mut() {
-                    batch.fill(batch.first_point, points, bodies);
+                    batch.fill(batch.first_point, Some(points), bodies);
                 }
             }
             return;
         }
+        self.make(Some(points), points.len(), bodies);
+    }
+
+    /// Plans the passes for the manifolds last `read` before their points are built, from
+    /// their entries alone: each manifold then goes into its lane, in the kept plan or in
+    /// a new one, as its points are built (`fill_manifold`). The entries read must be
+    /// those the points will make (`SoftStepSolver::plan_from_contacts` finds them).
+    pub fn plan_before_points(&mut self, point_count: usize, bodies: &[SoftBody]) {
+        if !self.kept_last_step {
+            self.make(None, point_count, bodies);
+        }
+        self.filled_while_built = true;
+    }
+
+    /// Whether the last step kept the plan before it (until this step's `read`).
+    pub fn kept_last_step(&self) -> bool {
+        self.kept_last_step
+    }
+
+    /// A new plan for the manifolds last `read` (of `point_count` points): their colours,
+    /// batches and `items`, and their lanes filled from `points` (or, without, left to
+    /// `fill_manifold`).
+    fn make(
+        &mut self,
+        points: Option<&[PointConstraint]>,
+        point_count: usize,
+        bodies: &[SoftBody],
+    ) {
         self.items.clear();
         self.pairs.clear();
         self.singles.clear();
@@ -353,7 +387,8 @@ impl PassPlan {
                 let ColouredManifold { first, count, .. } = self.coloured[i];
                 // Filling reads the points in colour order, scattered over the step's
                 // points (the smash's ~12 MB): they are asked for ahead.
-                if let Some(ahead) = self.coloured.get(i + PREFETCH_AHEAD) {
+                let ahead = self.coloured.get(i + PREFETCH_AHEAD);
+                if let (Some(ahead), Some(points)) = (ahead, points) {
                     prefetch(&points[ahead.first as usize..][..ahead.count as usize]);
                     prefetch(std::slice::from_ref(&bodies[ahead.bodies.0 as usize]));
                     prefetch(std::slice::from_ref(&bodies[ahead.bodies.1 as usize]));
@@ -373,7 +408,7 @@ impl PassPlan {
         }
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
         self.slot_of.clear();
-        self.slot_of.resize(points.len(), NO_SLOT);
+        self.slot_of.resize(point_count, NO_SLOT);
         let pairs = self.pairs.filled().iter().map(|b| (true, &b.first_point));
         let singles = self
             .singles
@@ -627,7 +662,7 @@ impl<const N: usize> BatchPool<N> {
     fn take(
         &mut self,
         first: u32,
-        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        (points, bodies): (Option<&[PointConstraint]>, &[SoftBody]),
         items: &mut Vec<PassItem>,
     ) {
         self.waiting[self.waiting_len] = first;
@@ -640,7 +675,7 @@ impl<const N: usize> BatchPool<N> {
     /// The waiting manifolds as the next batch, into `items`.
     fn push_batch(
         &mut self,
-        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        (points, bodies): (Option<&[PointConstraint]>, &[SoftBody]),
         items: &mut Vec<PassItem>,
     ) {
         self.waiting_len = 0;
@@ -661,7 +696,7 @@ impl<const N: usize> BatchPool<N> {
     /// lanes unused (`PAD`) if they are at least `pad_from`, else one by one into `items`.
     fn end_colour(
         &mut self,
-        (points, bodies): (&[PointConstraint], &[SoftBody]),
+        (points, bodies): (Option<&[PointConstraint]>, &[SoftBody]),
         items: &mut Vec<PassItem>,
         pad_from: usize,
     ) {
@@ -1083,15 +1118,23 @@ impl<const N: usize> ManifoldBatch<N> {
 
     /// Fills the batch with the manifolds whose first points are `first_point` (`PAD`:
     /// an unused lane, on the null body, the last of `bodies`).
-    fn fill(&mut self, first_point: [u32; LANES], points: &[PointConstraint], bodies: &[SoftBody]) {
+    /// Without `points`, only the unused lanes are filled: the others are filled as
+    /// their points are built (`PassPlan::plan_before_points`).
+    fn fill(
+        &mut self,
+        first_point: [u32; LANES],
+        points: Option<&[PointConstraint]>,
+        bodies: &[SoftBody],
+    ) {
         self.first_point = first_point;
         let unused = first_point
             .contains(&PAD)
             .then(|| unused_lane(bodies.len() as u32 - 1));
         for (k, &first) in first_point.iter().enumerate() {
-            let lane_points = match &unused {
-                Some(unused) if first == PAD => &unused[..],
-                _ => &points[first as usize..],
+            let lane_points = match (&unused, points) {
+                (Some(unused), _) if first == PAD => &unused[..],
+                (_, Some(points)) => &points[first as usize..],
+                (_, None) => continue,
             };
             self.fill_lane(k, first, &lane_points[..N], bodies);
         }
@@ -1730,7 +1773,7 @@ pub(super) mod tests {
     ) {
         for path in LanePath::available() {
             let mut batch = ManifoldBatch::<N>::default();
-            batch.fill(firsts, points, bodies);
+            batch.fill(firsts, Some(points), bodies);
             let (mut lanes, mut lane_points) = (bodies.to_vec(), points.to_vec());
             batch.solve_on(path, &mut lanes, pass);
             batch.scatter(&mut lane_points);
@@ -1799,8 +1842,8 @@ pub(super) mod tests {
             let mut reused = ManifoldBatch::<2>::default();
             for (k, points) in fills.into_iter().enumerate() {
                 let mut fresh = ManifoldBatch::<2>::default();
-                fresh.fill(FIRSTS, points, &bodies);
-                reused.fill(FIRSTS, points, &bodies);
+                fresh.fill(FIRSTS, Some(points), &bodies);
+                reused.fill(FIRSTS, Some(points), &bodies);
                 let expected = solved(&mut fresh, points);
                 assert_eq!(
                     solved(&mut reused, points),
@@ -1847,7 +1890,7 @@ pub(super) mod tests {
                 warm_start_point(&mut one_by_one, p);
             }
             let mut batch = ManifoldBatch::<2>::default();
-            batch.fill(FIRSTS, &points, &bodies);
+            batch.fill(FIRSTS, Some(&points), &bodies);
             for path in LanePath::available() {
                 let mut lanes = bodies.clone();
                 batch.warm_start_on(path, &mut lanes);
@@ -1908,7 +1951,7 @@ pub(super) mod tests {
         }
         let firsts = [0, 2, 4, 6, 8, PAD, PAD, PAD];
         let mut batch = ManifoldBatch::<2>::default();
-        batch.fill(firsts, &points, &bodies);
+        batch.fill(firsts, Some(&points), &bodies);
         batch.solve_on(LanePath::best(), &mut bodies, &pass(true));
         // Every contact's entry marked, so that an entry written by mistake shows.
         let unwritten = (-1.0, -1.0);
@@ -1970,7 +2013,7 @@ pub(super) mod tests {
             let (mut bodies, points) = eight_manifolds_both_ways(seed);
             bodies.push(SoftBody::null());
             let mut batch = ManifoldBatch::<2>::default();
-            batch.fill([0, 2, 4, PAD, PAD, PAD, PAD, PAD], &points, &bodies);
+            batch.fill([0, 2, 4, PAD, PAD, PAD, PAD, PAD], Some(&points), &bodies);
             batch.normal_impulses.iter_mut().for_each(mark);
             for p in &mut batch.points {
                 mark(&mut p.tangent_impulse);
@@ -2068,7 +2111,7 @@ pub(super) mod tests {
         assert_eq!(plan.items, kept);
         for batch in plan.batches() {
             let mut fresh = *batch;
-            fresh.fill(batch.first_point, &points, &bodies);
+            fresh.fill(batch.first_point, Some(&points), &bodies);
             let bits = |b: &ManifoldBatch<2>| {
                 let lanes = b.points.iter().flat_map(|p| p.tangent_impulse.0);
                 let impulses = b.normal_impulses.iter().flat_map(|l| l.0);
