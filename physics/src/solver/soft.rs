@@ -2088,6 +2088,42 @@ mod tests {
         (bodies, contacts)
     }
 
+    /// One step of 1/60 s of `bodies` under gravity (10 m/s² down every body) with a copy
+    /// of `contacts`, which it returns with the step's impulses.
+    fn step_falling(
+        solver: &mut SoftStepSolver,
+        bodies: &mut [SolverBody],
+        contacts: &[Contact],
+    ) -> Vec<Contact> {
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let mut contacts = contacts.to_vec();
+        let mut joints = [];
+        let h = 1.0 / 60.0;
+        solver.step(
+            &settings,
+            bodies,
+            &accelerations,
+            &mut contacts,
+            &mut joints,
+            h,
+            1.0,
+        );
+        contacts
+    }
+
+    /// Every body's velocity and pose and every contact's impulses, bit for bit.
+    fn state_bits(bodies: &[SolverBody], contacts: &[Contact]) -> Vec<u64> {
+        let states = bodies.iter().flat_map(|b| {
+            let (v, p) = (b.velocity, b.position);
+            [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
+        });
+        let impulses = contacts
+            .iter()
+            .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
+        states.chain(impulses).map(f64::to_bits).collect()
+    }
+
     /// After a step whose plan changed, the next plan is made from the contacts before the
     /// points are built, and each manifold goes straight into its lane. That must solve
     /// exactly as a solver that writes every point first and plans from them, through
@@ -2102,33 +2138,6 @@ mod tests {
         // changes at every step.
         let mut topless = whole.clone();
         topless.drain(58..60);
-        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
-        let settings = SoftSettings::for_length_scale(1.0);
-        let step = |solver: &mut SoftStepSolver, bodies: &mut Vec<SolverBody>, contacts| {
-            let mut contacts: Vec<Contact> = Vec::clone(contacts);
-            let mut joints = [];
-            let h = 1.0 / 60.0;
-            solver.step(
-                &settings,
-                bodies,
-                &accelerations,
-                &mut contacts,
-                &mut joints,
-                h,
-                1.0,
-            );
-            contacts
-        };
-        let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
-            let states = bodies.iter().flat_map(|b| {
-                let (v, p) = (b.velocity, b.position);
-                [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
-            });
-            let impulses = contacts
-                .iter()
-                .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
-            states.chain(impulses).map(f64::to_bits).collect()
-        };
         let mut first = SoftStepSolver::default();
         let mut after = SoftStepSolver {
             write_every_point: true,
@@ -2137,11 +2146,11 @@ mod tests {
         let (mut bodies_first, mut bodies_after) = (bodies.clone(), bodies);
         for k in 0..8 {
             let contacts = if k % 2 == 0 { &whole } else { &topless };
-            let contacts_first = step(&mut first, &mut bodies_first, contacts);
-            let contacts_after = step(&mut after, &mut bodies_after, contacts);
+            let contacts_first = step_falling(&mut first, &mut bodies_first, contacts);
+            let contacts_after = step_falling(&mut after, &mut bodies_after, contacts);
             assert_eq!(
-                bits(&bodies_first, &contacts_first),
-                bits(&bodies_after, &contacts_after),
+                state_bits(&bodies_first, &contacts_first),
+                state_bits(&bodies_after, &contacts_after),
                 "step {k}"
             );
         }
@@ -2164,7 +2173,6 @@ mod tests {
         // A column of 30 boxes (60 points: coloured into batches), one of 10 (20 points:
         // solved point by point) and a box alone (an LCP island).
         let (bodies, standing) = columns(&[30, 10, 1]);
-        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
         // Box 35 on box 20 instead of box 34: the two columns' islands change.
         let mut moved = standing.clone();
         for c in &mut moved[70..72] {
@@ -2180,32 +2188,6 @@ mod tests {
         // the same island.
         let mut second_moved = standing.clone();
         second_moved[21].body_b = 8;
-        let settings = SoftSettings::for_length_scale(1.0);
-        let step = |solver: &mut SoftStepSolver, bodies: &mut Vec<SolverBody>, contacts| {
-            let mut contacts: Vec<Contact> = Vec::clone(contacts);
-            let h = 1.0 / 60.0;
-            let mut joints = [];
-            solver.step(
-                &settings,
-                bodies,
-                &accelerations,
-                &mut contacts,
-                &mut joints,
-                h,
-                1.0,
-            );
-            contacts
-        };
-        let bits = |bodies: &[SolverBody], contacts: &[Contact]| -> Vec<u64> {
-            let states = bodies.iter().flat_map(|b| {
-                let (v, p) = (b.velocity, b.position);
-                [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
-            });
-            let impulses = contacts
-                .iter()
-                .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
-            states.chain(impulses).map(f64::to_bits).collect()
-        };
         // The first steps' contacts and the last step's, whether the last step's grouping
         // is the first steps' kept unchecked, and whether it is another.
         let cases = [
@@ -2221,8 +2203,8 @@ mod tests {
             // Steps enough for the plan to be kept, and its lanes filled as the points
             // are built.
             for _ in 0..4 {
-                step(&mut unchecked, &mut bodies_unchecked, first);
-                step(&mut fresh, &mut bodies_fresh, first);
+                step_falling(&mut unchecked, &mut bodies_unchecked, first);
+                step_falling(&mut fresh, &mut bodies_fresh, first);
             }
             assert!(
                 unchecked.steps_skipping.0 > 0,
@@ -2230,11 +2212,11 @@ mod tests {
             );
             let first_grouping = unchecked.contact_grouping.grouped().to_vec();
             fresh.contact_grouping = IslandGrouping::default();
-            let contacts_unchecked = step(&mut unchecked, &mut bodies_unchecked, last);
-            let contacts_fresh = step(&mut fresh, &mut bodies_fresh, last);
+            let contacts_unchecked = step_falling(&mut unchecked, &mut bodies_unchecked, last);
+            let contacts_fresh = step_falling(&mut fresh, &mut bodies_fresh, last);
             assert_eq!(
-                bits(&bodies_unchecked, &contacts_unchecked),
-                bits(&bodies_fresh, &contacts_fresh)
+                state_bits(&bodies_unchecked, &contacts_unchecked),
+                state_bits(&bodies_fresh, &contacts_fresh)
             );
             let grouping = unchecked.contact_grouping.grouped();
             assert_eq!(grouping, fresh.contact_grouping.grouped());
