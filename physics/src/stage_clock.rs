@@ -32,12 +32,14 @@ pub enum Stage {
     /// a pile at rest, only the bodies' freedom checked: the last grouping is taken, and
     /// the contacts' bodies are checked as their points are built).
     PreparingIslands,
-    /// Within `Preparing`: the contacts' points built, and the kept plan's lanes filled
-    /// from them (`SoftStepSolver::build_points`, twice if the plan changed after all or
-    /// the contacts' grouping taken unchecked was not theirs).
+    /// Within `Preparing`: the contacts' points built, and the lanes of the kept plan, or
+    /// of a plan made before them, filled from them (`SoftStepSolver::build_points`,
+    /// twice if the plan changed after all or the contacts' grouping taken unchecked was
+    /// not theirs).
     PreparingPoints,
     /// Within `Preparing`: the small islands' LCPs set up, and the plan read and, if it
-    /// changed, made again (colours and batches).
+    /// changed, made again (colours and batches); after a step whose plan changed, read
+    /// off the contacts and made before the points (`plan_from_contacts`).
     PreparingPlan,
 }
 

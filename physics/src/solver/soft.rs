@@ -626,10 +626,9 @@ impl SoftStepSolver {
         // there, read in colour order, into its lane (docs/bench/profile.md, "The plan
         // made before the points").
         let started = stage_clock::mark();
-        #[cfg(not(test))]
         let may_plan_first = !reused && !self.plan.kept_last_step();
         #[cfg(test)]
-        let may_plan_first = !reused && !self.plan.kept_last_step() && !self.write_every_point;
+        let may_plan_first = may_plan_first && !self.write_every_point;
         let planned_first =
             may_plan_first && self.plan_from_contacts(bodies, contacts, grouping.grouped());
         if planned_first {
@@ -670,15 +669,12 @@ impl SoftStepSolver {
         debug_assert!(
             !planned_first || (self.plan_inputs == self.planned_inputs && !self.may_bounce)
         );
-        if planned_first {
-            self.plan.stop_filling();
-        }
         let kept = planned_first
             || self
                 .plan
                 .read(&self.contact_lcp.all_islands, &self.plan_inputs);
         stage_clock::record(Stage::PreparingPlan, started);
-        let rebuild = skipped && !planned_first && (!kept || self.may_bounce);
+        let rebuild = skipped && (!kept || self.may_bounce);
         #[cfg(test)]
         {
             self.steps_skipping.0 += usize::from(skipped);
@@ -2129,6 +2125,33 @@ mod tests {
         states.chain(impulses).map(f64::to_bits).collect()
     }
 
+    /// A solver stepped `steps` times (`step_falling`) beside one that writes every point
+    /// and plans from them, with the two contact lists in turn; both must leave the
+    /// bodies and the impulses the same, bit for bit, after every step. Returns the two.
+    fn step_beside_one_writing_every_point(
+        bodies: Vec<SolverBody>,
+        contacts_in_turn: [&[Contact]; 2],
+        steps: usize,
+    ) -> (SoftStepSolver, SoftStepSolver) {
+        let mut solver = SoftStepSolver::default();
+        let mut writing = SoftStepSolver {
+            write_every_point: true,
+            ..SoftStepSolver::default()
+        };
+        let (mut bodies_solver, mut bodies_writing) = (bodies.clone(), bodies);
+        for k in 0..steps {
+            let contacts = contacts_in_turn[k % 2];
+            let contacts_solver = step_falling(&mut solver, &mut bodies_solver, contacts);
+            let contacts_writing = step_falling(&mut writing, &mut bodies_writing, contacts);
+            assert_eq!(
+                state_bits(&bodies_solver, &contacts_solver),
+                state_bits(&bodies_writing, &contacts_writing),
+                "step {k}"
+            );
+        }
+        (solver, writing)
+    }
+
     /// After a step whose plan changed, the next plan is made from the contacts before the
     /// points are built, and each manifold goes straight into its lane. That must solve
     /// exactly as a solver that writes every point first and plans from them, through
@@ -2143,22 +2166,7 @@ mod tests {
         // changes at every step.
         let mut topless = whole.clone();
         topless.drain(58..60);
-        let mut first = SoftStepSolver::default();
-        let mut after = SoftStepSolver {
-            write_every_point: true,
-            ..SoftStepSolver::default()
-        };
-        let (mut bodies_first, mut bodies_after) = (bodies.clone(), bodies);
-        for k in 0..8 {
-            let contacts = if k % 2 == 0 { &whole } else { &topless };
-            let contacts_first = step_falling(&mut first, &mut bodies_first, contacts);
-            let contacts_after = step_falling(&mut after, &mut bodies_after, contacts);
-            assert_eq!(
-                state_bits(&bodies_first, &contacts_first),
-                state_bits(&bodies_after, &contacts_after),
-                "step {k}"
-            );
-        }
+        let (first, after) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 8);
         // Every step: each changes the plan (the first makes one).
         assert_eq!(first.steps_planned_first, 8);
         assert_eq!(after.steps_planned_first, 0);
@@ -2179,22 +2187,7 @@ mod tests {
         whole[41].approach_velocity = -2.0;
         let mut topless = whole.clone();
         topless.drain(58..60);
-        let mut solver = SoftStepSolver::default();
-        let mut writing = SoftStepSolver {
-            write_every_point: true,
-            ..SoftStepSolver::default()
-        };
-        let (mut bodies_solver, mut bodies_writing) = (bodies.clone(), bodies);
-        for k in 0..6 {
-            let contacts = if k % 2 == 0 { &whole } else { &topless };
-            let contacts_solver = step_falling(&mut solver, &mut bodies_solver, contacts);
-            let contacts_writing = step_falling(&mut writing, &mut bodies_writing, contacts);
-            assert_eq!(
-                state_bits(&bodies_solver, &contacts_solver),
-                state_bits(&bodies_writing, &contacts_writing),
-                "step {k}"
-            );
-        }
+        let (solver, _) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 6);
         assert_eq!(solver.steps_planned_first, 0);
     }
 
