@@ -38,13 +38,20 @@ impl ContactMemory {
     }
 
     /// The last impulses of `contact`, the `k`-th of this step's contacts, if the `k`-th
-    /// entry is its own, as it is where no contact came or went before it. `None` says
-    /// only that this guess missed (`recall` finds them all).
+    /// entry is its own, as it is where no contact came or went before it, or if one of
+    /// its neighbours is: a manifold's two points may come in the other order than last
+    /// step's (large_pyramid had such a swap somewhere in half its steps at rest, and
+    /// each cost a `recall` of all 30,000 contacts). A key is a contact's alone, so the
+    /// entry found is the one `recall` finds. `None` says only that this guess missed
+    /// (`recall` finds them all).
     #[inline]
     pub fn guess(&self, k: usize, contact: &Contact) -> Option<(f64, f64)> {
         let key = key(contact);
-        let m = self.entries.get(k)?;
-        (m.0 == key).then_some((m.1, m.2))
+        let own = |m: &&Entry| m.0 == key;
+        let m = [k, k + 1, k.wrapping_sub(1)]
+            .into_iter()
+            .find_map(|j| self.entries.get(j).filter(own))?;
+        Some((m.1, m.2))
     }
 
     /// Each contact's last (normal, tangent) impulses, zeros for a new one, into `out` in
@@ -358,6 +365,33 @@ mod tests {
         assert_eq!(found, 6, "{recalled:?}");
         memory.recall(&[], &mut recalled);
         assert!(recalled.is_empty());
+    }
+
+    /// A guess finds a contact's entry at its own index or beside it (a manifold's two
+    /// points the other way round), with the impulses a search finds, and misses
+    /// anything further off or new.
+    #[test]
+    fn a_guess_finds_a_manifolds_points_in_either_order() {
+        let last = contacts(
+            &[(0, 1, 7), (0, 1, 9), (2, 3, 1), (2, 3, 4), (5, 6, 2)],
+            10.0,
+        );
+        let mut memory = ContactMemory::default();
+        memory.store(&last);
+        let now = contacts(
+            &[(0, 1, 9), (0, 1, 7), (2, 3, 4), (2, 3, 1), (5, 6, 2)],
+            0.0,
+        );
+        let guessed: Vec<_> = (0..now.len()).map(|k| memory.guess(k, &now[k])).collect();
+        let searched: Vec<_> = searched(&last, &now).into_iter().map(Some).collect();
+        assert_eq!(guessed, searched);
+        // Two entries off (a contact gone before it), and a contact not in the memory.
+        let shifted = contacts(&[(2, 3, 1), (2, 3, 4), (5, 6, 2), (7, 8, 1)], 0.0);
+        assert_eq!(memory.guess(0, &shifted[2]), None);
+        assert_eq!(memory.guess(3, &shifted[3]), None);
+        assert_eq!(memory.guess(7, &shifted[2]), None);
+        // Past the last entry, beside it.
+        assert_eq!(memory.guess(5, &shifted[2]), searched[4]);
     }
 
     /// The same over thousands of contacts: many gone and many new (pairs skipped over by

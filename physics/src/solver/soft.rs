@@ -508,7 +508,7 @@ struct Reading<'a> {
 }
 
 /// How `build_points` finds the last step's impulses: guessing each contact's entry at
-/// its own index until a guess misses, then from all of them recalled at once.
+/// (or beside) its own index until a guess misses, then from all of them recalled at once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Recall {
     Guessing,
@@ -960,9 +960,9 @@ impl SoftStepSolver {
             if k > 0.0 { 1.0 / k } else { 0.0 }
         };
         // A pile at rest has the same contacts in the same order, each its entry at its
-        // own index (`ContactMemory::guess`); at the first that is not, every contact's
-        // impulses are recalled at once, in the contacts' order, which the memory's
-        // follows (the points are built in the islands').
+        // own index or beside it (`ContactMemory::guess`); at the first that is not,
+        // every contact's impulses are recalled at once, in the contacts' order, which
+        // the memory's follows (the points are built in the islands').
         let guessed = match recall {
             Recall::Guessing => self.memory.guess(i as usize, c),
             Recall::AllRecalled => None,
