@@ -50,12 +50,14 @@ const MIN_COLOURED_ISLAND: usize = 48;
 const PREFETCH_AHEAD: usize = 16;
 
 /// From how many bytes of batches the passes ask for each next batch while solving one
-/// (`PassPlan::batches_ahead`). More than a level-2 cache holds beside the bodies,
-/// they come from farther out in every pass, and the first reads of each batch waited:
-/// asked for ahead, the smash's passes took 30% less time on the Zen 1, large_pyramid's
-/// and many_pyramids' 15–25%. A pile that stays in the cache gains nothing and pays for
-/// the asking (pyramid20's passes 3% slower). The warm start asks for what it reads too.
-const ASK_AHEAD_FROM_BYTES: usize = 256 * 1024;
+/// (`PassPlan::batches_ahead`). Many megabytes of them come from farther out in every
+/// pass, and the first reads of each batch waited: asked for ahead, the smash's passes
+/// (6.5 MB of batches at step 120) took 30% less time on the Zen 1, large_pyramid's and
+/// many_pyramids' (4.9–5.0 MB) 15–25%. Batches that stay in the caches gain nothing and
+/// pay for the asking: pyramid20's (207 KB) passes 3% slower, pyramid40's (806 KB, past
+/// the level-2 cache but well inside the level-3) warm start 9–12% slower and its solve
+/// 1–2%. The warm start asks for what it reads too.
+const ASK_AHEAD_FROM_BYTES: usize = 2 * 1024 * 1024;
 
 /// Where the step's batches lie (`PassPlan::batches_ahead`), kept apart from their
 /// borrow so that a pass holding them mutably can still ask for the next one. The
