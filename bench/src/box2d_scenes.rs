@@ -11,7 +11,9 @@ use crate::scene::{
     PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid,
     momentum_and_kinetic_energy, smash, worst,
 };
-use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef};
+use boxdd::{
+    BodyBuilder, BodyId, BodyType, Profile, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef,
+};
 
 /// Box2D's default substep count for `b2World_Step`.
 pub const SUBSTEPS: i32 = 4;
@@ -80,16 +82,8 @@ fn floor(w: &mut World, top: f64) {
 
 /// A pyramid (or stack) stepped at `h` for `spec.steps`.
 pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
-    let mut w = world();
-    for top in spec.floor_tops() {
-        floor(&mut w, top);
-    }
-    let centres = spec.centres();
-    let boxes: Vec<BodyId> = centres
-        .iter()
-        .map(|&c| boxed(&mut w, BodyType::Dynamic, c, (BOX, BOX), 1.0, 0.0))
-        .collect();
-    let mut tracker = PyramidTracker::new(centres);
+    let (mut w, boxes) = pyramid_world(spec);
+    let mut tracker = PyramidTracker::new(spec.centres());
     let timing = measure(
         &mut w,
         spec.steps,
@@ -97,6 +91,32 @@ pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
+}
+
+/// The pyramid `spec` on its floor, and its boxes in the order of `Pyramid::centres`.
+fn pyramid_world(spec: &Pyramid) -> (World, Vec<BodyId>) {
+    let mut w = world();
+    for top in spec.floor_tops() {
+        floor(&mut w, top);
+    }
+    let boxes = spec
+        .centres()
+        .iter()
+        .map(|&c| boxed(&mut w, BodyType::Dynamic, c, (BOX, BOX), 1.0, 0.0))
+        .collect();
+    (w, boxes)
+}
+
+/// Box2D v3's own timing of each of `steps` steps of the pyramid `spec`
+/// (`b2World_GetProfile`), which `stages` sets beside pe's stage clock.
+pub fn pyramid_profiles(spec: &Pyramid, h: f64, substeps: i32, steps: usize) -> Vec<Profile> {
+    let (mut w, _) = pyramid_world(spec);
+    (0..steps)
+        .map(|_| {
+            step(&mut w, h, substeps);
+            w.profile()
+        })
+        .collect()
 }
 
 /// One body's motion, from its mass properties.

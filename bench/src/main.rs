@@ -3,7 +3,8 @@
 //! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots; with
 //! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
 //! outcome; with `throws [count] [seed] [list]`, the random throws alone (`throws.rs`),
-//! listing each that sinks with `list`.
+//! listing each that sinks with `list`; with `stages <pyramid>` (feature `stages`), pe's
+//! stages beside Box2D v3's own profile of the same pyramid.
 //!
 //! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws]` inside bench/.
 
@@ -134,6 +135,10 @@ fn main() {
     }
     if std::env::args().nth(1).as_deref() == Some("pe") {
         run_pe_alone();
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("stages") {
+        run_stages_beside_box2d();
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("pile") {
@@ -294,6 +299,168 @@ fn print_stage_cycles(from: Option<usize>) {
         let fewest = cycles[0];
         let median = cycles[cycles.len() / 2];
         println!("| {} | {fewest} | {median} |", stage.name());
+    }
+}
+
+/// `stages <pyramid> [steps=N] [from=K]`, in a build with the feature `stages`: pe
+/// `soft`'s stage clock and Box2D v3's own profile (`b2World_GetProfile`) on the same
+/// pyramid, one engine's run after the other's, each stage's median microseconds over the
+/// steps from the K-th (half way by default), the stages matched as closely as the two
+/// steps allow. Box2D times its stages with the wall clock, pe with the time-stamp
+/// counter, converted here at its rate measured against the wall clock.
+fn run_stages_beside_box2d() {
+    use pe::stage_clock::{self, Stage};
+    let args: Vec<String> = std::env::args().skip(2).collect();
+    let Some(spec) = args
+        .first()
+        .and_then(|name| PYRAMIDS.iter().find(|p| p.name == name.as_str()))
+    else {
+        let names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
+        eprintln!("stages: one of {}", names.join(", "));
+        std::process::exit(2);
+    };
+    if !stage_clock::ENABLED {
+        eprintln!("stages: build with `--features stages` to count them");
+        std::process::exit(2);
+    }
+    let number = |prefix: &str| {
+        args.iter()
+            .find_map(|f| f.strip_prefix(prefix)?.parse::<usize>().ok())
+    };
+    let steps = number("steps=").unwrap_or(spec.steps).max(2);
+    let from = number("from=").unwrap_or(steps / 2).min(steps - 1);
+    harness::fixed_steps(steps);
+    let pe_run = pe_scenes::pyramid(PeConfig::new(ContactSolver::Soft), spec, H);
+    let pe_steps = stage_clock::take_steps();
+    let ticks_per_microsecond = stage_clock_rate();
+    let box2d = box2d_scenes::pyramid_profiles(spec, H, box2d_scenes::SUBSTEPS, steps);
+    let median = |mut values: Vec<f64>| {
+        values.sort_by(f64::total_cmp);
+        values[values.len() / 2]
+    };
+    let pe_time = |stages: &[Stage]| {
+        let column = |stage: &Stage| Stage::ALL.iter().position(|s| s == stage).expect("a stage");
+        median(
+            pe_steps[from..]
+                .iter()
+                .map(|step| {
+                    let ticks: u64 = stages.iter().map(|s| step[column(s)]).sum();
+                    ticks as f64 / ticks_per_microsecond
+                })
+                .collect(),
+        )
+    };
+    let box2d_time = |fields: &dyn Fn(&boxdd::Profile) -> f32| {
+        median(
+            box2d[from..]
+                .iter()
+                .map(|p| 1000.0 * f64::from(fields(p)))
+                .collect(),
+        )
+    };
+    // (what, pe's stages, Box2D v3's fields and their names)
+    type Fields = fn(&boxdd::Profile) -> f32;
+    let rows: [(&str, &[Stage], Fields, &str); 7] = [
+        (
+            "broad phase",
+            &[Stage::BroadPhase],
+            |p| p.pairs + p.refit,
+            "pairs + refit",
+        ),
+        (
+            "narrow phase and contacts",
+            &[Stage::NarrowPhase, Stage::Contacts],
+            |p| p.collide,
+            "collide",
+        ),
+        (
+            "preparing",
+            &[Stage::Preparing],
+            |p| p.prepare_stages + p.prepare_constraints,
+            "prepareStages + prepareConstraints",
+        ),
+        (
+            "velocities integrated",
+            &[],
+            |p| p.integrate_velocities,
+            "integrateVelocities (pe: in the rest)",
+        ),
+        (
+            "warm start",
+            &[Stage::WarmStart],
+            |p| p.warm_start,
+            "warmStart",
+        ),
+        (
+            "solve",
+            &[Stage::Solve],
+            |p| p.solve_impulses + p.integrate_positions + p.relax_impulses,
+            "solveImpulses + integratePositions + relaxImpulses",
+        ),
+        (
+            "storing",
+            &[Stage::Storing],
+            |p| p.store_impulses + p.transforms,
+            "storeImpulses + transforms",
+        ),
+    ];
+    let whole = (pe_time(&[Stage::Step]), box2d_time(&|p| p.step));
+    println!(
+        "{} under pe soft: {pe_run:?}\n\n{} over {} steps from step {from}, median \
+         microseconds a step (the stage clock at {ticks_per_microsecond:.0} ticks a \
+         microsecond)\n",
+        spec.name,
+        spec.name,
+        steps - from,
+    );
+    println!("| stage | pe soft | Box2D v3 | pe − Box2D v3 | Box2D v3's fields |");
+    println!("| --- | ---: | ---: | ---: | --- |");
+    let mut parts = (0.0, 0.0);
+    for (name, stages, fields, field_names) in rows {
+        let (pe, b2) = (
+            if stages.is_empty() {
+                0.0
+            } else {
+                pe_time(stages)
+            },
+            box2d_time(&fields),
+        );
+        parts = (parts.0 + pe, parts.1 + b2);
+        println!(
+            "| {name} | {pe:.0} | {b2:.0} | {:+.0} | {field_names} |",
+            pe - b2
+        );
+    }
+    let rest = (whole.0 - parts.0, whole.1 - parts.1);
+    println!(
+        "| the rest (whole step less the medians above) | {:.0} | {:.0} | {:+.0} | step less the above |",
+        rest.0,
+        rest.1,
+        rest.0 - rest.1
+    );
+    println!(
+        "| whole step | {:.0} | {:.0} | {:+.0} | step |",
+        whole.0,
+        whole.1,
+        whole.0 - whole.1
+    );
+}
+
+/// The stage clock's ticks a microsecond: the time-stamp counter against the wall clock
+/// over a tenth of a second (on x86-64; elsewhere the clock counts nanoseconds).
+fn stage_clock_rate() -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: `rdtsc` has no preconditions on x86-64.
+        let ticks = || unsafe { std::arch::x86_64::_rdtsc() };
+        let (started, first) = (Instant::now(), ticks());
+        while started.elapsed() < Duration::from_millis(100) {}
+        let last = ticks();
+        (last - first) as f64 / started.elapsed().as_secs_f64() / 1e6
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        1000.0
     }
 }
 
