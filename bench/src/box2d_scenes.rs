@@ -14,6 +14,8 @@ use crate::scene::{
 use boxdd::{
     BodyBuilder, BodyId, BodyType, Profile, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef,
 };
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Box2D's default substep count for `b2World_Step`.
 pub const SUBSTEPS: i32 = 4;
@@ -32,6 +34,24 @@ fn world() -> World {
 
 fn step(w: &mut World, h: f64, substeps: i32) {
     w.step(h as f32, substeps);
+    if KEEP_PROFILES.load(Ordering::Relaxed) {
+        PROFILES.lock().expect("no step panicked").push(w.profile());
+    }
+}
+
+/// Whether `step` keeps Box2D v3's own timing of each step (`b2World_GetProfile`), for
+/// `stages` to set beside pe's stage clock.
+static KEEP_PROFILES: AtomicBool = AtomicBool::new(false);
+static PROFILES: Mutex<Vec<Profile>> = Mutex::new(Vec::new());
+
+/// From now on, every step's profile is kept, until `take_profiles`.
+pub fn keep_profiles() {
+    KEEP_PROFILES.store(true, Ordering::Relaxed);
+}
+
+/// The profiles of the steps taken since `keep_profiles` or the last call, in order.
+pub fn take_profiles() -> Vec<Profile> {
+    std::mem::take(&mut PROFILES.lock().expect("no step panicked"))
 }
 
 /// A box of full size `w` × `h` on a new body; Box2D mixes friction by the geometric mean
@@ -82,8 +102,16 @@ fn floor(w: &mut World, top: f64) {
 
 /// A pyramid (or stack) stepped at `h` for `spec.steps`.
 pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
-    let (mut w, boxes) = pyramid_world(spec);
-    let mut tracker = PyramidTracker::new(spec.centres());
+    let mut w = world();
+    for top in spec.floor_tops() {
+        floor(&mut w, top);
+    }
+    let centres = spec.centres();
+    let boxes: Vec<BodyId> = centres
+        .iter()
+        .map(|&c| boxed(&mut w, BodyType::Dynamic, c, (BOX, BOX), 1.0, 0.0))
+        .collect();
+    let mut tracker = PyramidTracker::new(centres);
     let timing = measure(
         &mut w,
         spec.steps,
@@ -91,32 +119,6 @@ pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
-}
-
-/// The pyramid `spec` on its floor, and its boxes in the order of `Pyramid::centres`.
-fn pyramid_world(spec: &Pyramid) -> (World, Vec<BodyId>) {
-    let mut w = world();
-    for top in spec.floor_tops() {
-        floor(&mut w, top);
-    }
-    let boxes = spec
-        .centres()
-        .iter()
-        .map(|&c| boxed(&mut w, BodyType::Dynamic, c, (BOX, BOX), 1.0, 0.0))
-        .collect();
-    (w, boxes)
-}
-
-/// Box2D v3's own timing of each of `steps` steps of the pyramid `spec`
-/// (`b2World_GetProfile`), which `stages` sets beside pe's stage clock.
-pub fn pyramid_profiles(spec: &Pyramid, h: f64, substeps: i32, steps: usize) -> Vec<Profile> {
-    let (mut w, _) = pyramid_world(spec);
-    (0..steps)
-        .map(|_| {
-            step(&mut w, h, substeps);
-            w.profile()
-        })
-        .collect()
 }
 
 /// One body's motion, from its mass properties.

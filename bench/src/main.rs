@@ -3,8 +3,8 @@
 //! with `sweep`, the work–precision sweeps to docs/bench/sweep.md and their plots; with
 //! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
 //! outcome; with `throws [count] [seed] [list]`, the random throws alone (`throws.rs`),
-//! listing each that sinks with `list`; with `stages <pyramid>` (feature `stages`), pe's
-//! stages beside Box2D v3's own profile of the same pyramid.
+//! listing each that sinks with `list`; with `stages <scene>` (feature `stages`), pe's
+//! stages beside Box2D v3's own profile of the same scene.
 //!
 //! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws]` inside bench/.
 
@@ -302,21 +302,19 @@ fn print_stage_cycles(from: Option<usize>) {
     }
 }
 
-/// `stages <pyramid> [steps=N] [from=K]`, in a build with the feature `stages`: pe
-/// `soft`'s stage clock and Box2D v3's own profile (`b2World_GetProfile`) on the same
-/// pyramid, one engine's run after the other's, each stage's median microseconds over the
-/// steps from the K-th (half way by default), the stages matched as closely as the two
-/// steps allow. Box2D times its stages with the wall clock, pe with the time-stamp
-/// counter, converted here at its rate measured against the wall clock.
+/// `stages <scene> [steps=N] [from=K]`, in a build with the feature `stages`: pe
+/// `soft`'s stage clock and Box2D v3's own profile (`b2World_GetProfile`) on one of
+/// `pile_scenes`, one engine's N steps (300 by default) after the other's, each stage's
+/// median microseconds over the steps from the K-th (half way by default), the stages
+/// matched as closely as the two steps allow. Box2D times its stages with the wall
+/// clock, pe with the time-stamp counter, converted here at its rate measured against
+/// the wall clock.
 fn run_stages_beside_box2d() {
     use pe::stage_clock::{self, Stage};
     let args: Vec<String> = std::env::args().skip(2).collect();
-    let Some(spec) = args
-        .first()
-        .and_then(|name| PYRAMIDS.iter().find(|p| p.name == name.as_str()))
-    else {
-        let names: Vec<&str> = PYRAMIDS.iter().map(|p| p.name).collect();
-        eprintln!("stages: one of {}", names.join(", "));
+    let scene = args.first().cloned().unwrap_or_default();
+    let Some(mut jobs) = pile_jobs(&scene) else {
+        eprintln!("stages: one of {}", pile_scenes().join(", "));
         std::process::exit(2);
     };
     if !stage_clock::ENABLED {
@@ -327,24 +325,27 @@ fn run_stages_beside_box2d() {
         args.iter()
             .find_map(|f| f.strip_prefix(prefix)?.parse::<usize>().ok())
     };
-    let steps = number("steps=").unwrap_or(spec.steps).max(2);
+    let steps = number("steps=").unwrap_or(300).max(2);
     let from = number("from=").unwrap_or(steps / 2).min(steps - 1);
     harness::fixed_steps(steps);
-    let pe_run = pe_scenes::pyramid(PeConfig::new(ContactSolver::Soft), spec, H);
+    // `pile_jobs`: pe `soft`, rapier2d, Box2D v3.
+    let box2d_job = jobs.pop().expect("Box2D v3's job");
+    let pe_run = jobs.swap_remove(0)();
     let pe_steps = stage_clock::take_steps();
     let ticks_per_microsecond = stage_clock_rate();
-    let box2d = box2d_scenes::pyramid_profiles(spec, H, box2d_scenes::SUBSTEPS, steps);
+    box2d_scenes::keep_profiles();
+    box2d_job();
+    let box2d = box2d_scenes::take_profiles();
     let median = |mut values: Vec<f64>| {
         values.sort_by(f64::total_cmp);
         values[values.len() / 2]
     };
     let pe_time = |stages: &[Stage]| {
-        let column = |stage: &Stage| Stage::ALL.iter().position(|s| s == stage).expect("a stage");
         median(
             pe_steps[from..]
                 .iter()
                 .map(|step| {
-                    let ticks: u64 = stages.iter().map(|s| step[column(s)]).sum();
+                    let ticks: u64 = stages.iter().map(|&s| step[s as usize]).sum();
                     ticks as f64 / ticks_per_microsecond
                 })
                 .collect(),
@@ -360,7 +361,7 @@ fn run_stages_beside_box2d() {
     };
     // (what, pe's stages, Box2D v3's fields and their names)
     type Fields = fn(&boxdd::Profile) -> f32;
-    let rows: [(&str, &[Stage], Fields, &str); 7] = [
+    let rows: [(&str, &[Stage], Fields, &str); 8] = [
         (
             "broad phase",
             &[Stage::BroadPhase],
@@ -403,14 +404,18 @@ fn run_stages_beside_box2d() {
             |p| p.store_impulses + p.transforms,
             "storeImpulses + transforms",
         ),
+        (
+            "continuous collision",
+            &[Stage::Continuous],
+            |p| p.bullets,
+            "bullets (other fast bodies: in transforms)",
+        ),
     ];
     let whole = (pe_time(&[Stage::Step]), box2d_time(&|p| p.step));
     println!(
-        "{} under pe soft: {pe_run:?}\n\n{} over {} steps from step {from}, median \
-         microseconds a step (the stage clock at {ticks_per_microsecond:.0} ticks a \
-         microsecond)\n",
-        spec.name,
-        spec.name,
+        "{scene} under pe soft: {pe_run:?}\n\n{scene} over {} steps from step {from}, \
+         median microseconds a step (the stage clock at {ticks_per_microsecond:.0} ticks \
+         a microsecond)\n",
         steps - from,
     );
     println!("| stage | pe soft | Box2D v3 | pe − Box2D v3 | Box2D v3's fields |");

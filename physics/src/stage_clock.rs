@@ -41,10 +41,13 @@ pub enum Stage {
     /// changed, made again (colours and batches); after a step whose plan changed, read
     /// off the contacts and made before the points (`plan_from_contacts`).
     PreparingPlan,
+    /// Continuous collision after the step: fast bodies that passed into a static one
+    /// moved back to the impact (`World::stop_at_impact`), under every solver.
+    Continuous,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 11] = [
+    pub const ALL: [Stage; 12] = [
         Stage::Step,
         Stage::BroadPhase,
         Stage::NarrowPhase,
@@ -56,6 +59,7 @@ impl Stage {
         Stage::PreparingIslands,
         Stage::PreparingPoints,
         Stage::PreparingPlan,
+        Stage::Continuous,
     ];
 
     /// The stage this one is a part of, if any (its cycles are counted in both).
@@ -81,6 +85,7 @@ impl Stage {
             Stage::PreparingIslands => "preparing: bodies, islands",
             Stage::PreparingPoints => "preparing: points",
             Stage::PreparingPlan => "preparing: LCPs, plan",
+            Stage::Continuous => "continuous collision",
         }
     }
 }

@@ -632,7 +632,9 @@ impl World {
         self.clear_forces();
         self.step_count += 1;
         if self.settings.continuous {
+            let started = stage_clock::mark();
             self.stop_at_impact();
+            stage_clock::record(Stage::Continuous, started);
         }
         if self.settings.sleeping {
             self.sleep_where_still(dt);
