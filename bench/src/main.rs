@@ -306,9 +306,9 @@ fn print_stage_cycles(from: Option<usize>) {
 /// `soft`'s stage clock and Box2D v3's own profile (`b2World_GetProfile`) on one of
 /// `pile_scenes`, one engine's N steps (300 by default) after the other's, each stage's
 /// median microseconds over the steps from the K-th (half way by default), the stages
-/// matched as closely as the two steps allow. Box2D times its stages with the wall
-/// clock, pe with the time-stamp counter, converted here at its rate measured against
-/// the wall clock.
+/// matched as closely as the two steps allow (a row with no pe stage reads 0). Box2D
+/// times its stages with the wall clock, pe with its stage clock, converted at the rate
+/// `stage_clock::ticks_per_microsecond` measures.
 fn run_stages_beside_box2d() {
     use pe::stage_clock::{self, Stage};
     let args: Vec<String> = std::env::args().skip(2).collect();
@@ -332,7 +332,7 @@ fn run_stages_beside_box2d() {
     let box2d_job = jobs.pop().expect("Box2D v3's job");
     let pe_run = jobs.swap_remove(0)();
     let pe_steps = stage_clock::take_steps();
-    let ticks_per_microsecond = stage_clock_rate();
+    let ticks_per_microsecond = stage_clock::ticks_per_microsecond().expect("enabled");
     box2d_scenes::keep_profiles();
     box2d_job();
     let box2d = box2d_scenes::take_profiles();
@@ -422,14 +422,7 @@ fn run_stages_beside_box2d() {
     println!("| --- | ---: | ---: | ---: | --- |");
     let mut parts = (0.0, 0.0);
     for (name, stages, fields, field_names) in rows {
-        let (pe, b2) = (
-            if stages.is_empty() {
-                0.0
-            } else {
-                pe_time(stages)
-            },
-            box2d_time(&fields),
-        );
+        let (pe, b2) = (pe_time(stages), box2d_time(&fields));
         parts = (parts.0 + pe, parts.1 + b2);
         println!(
             "| {name} | {pe:.0} | {b2:.0} | {:+.0} | {field_names} |",
@@ -449,24 +442,6 @@ fn run_stages_beside_box2d() {
         whole.1,
         whole.0 - whole.1
     );
-}
-
-/// The stage clock's ticks a microsecond: the time-stamp counter against the wall clock
-/// over a tenth of a second (on x86-64; elsewhere the clock counts nanoseconds).
-fn stage_clock_rate() -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: `rdtsc` has no preconditions on x86-64.
-        let ticks = || unsafe { std::arch::x86_64::_rdtsc() };
-        let (started, first) = (Instant::now(), ticks());
-        while started.elapsed() < Duration::from_millis(100) {}
-        let last = ticks();
-        (last - first) as f64 / started.elapsed().as_secs_f64() / 1e6
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        1000.0
-    }
 }
 
 /// The scenes of `pile`: every pile, the joint grid and the smash.

@@ -175,6 +175,25 @@ pub fn take_steps() -> Vec<[u64; Stage::ALL.len()]> {
     }
 }
 
+/// How many of the clock's ticks pass in a microsecond (the time-stamp counter's rate on
+/// x86-64; about 1,000 elsewhere, where it counts nanoseconds), measured against the wall
+/// clock over a tenth of a second: to turn `take_steps`' counts into time. `None` without
+/// the feature.
+pub fn ticks_per_microsecond() -> Option<f64> {
+    #[cfg(feature = "stage-clock")]
+    {
+        use std::time::{Duration, Instant};
+        let (started, first) = (Instant::now(), counting::now());
+        while started.elapsed() < Duration::from_millis(100) {}
+        let ticks = counting::now().wrapping_sub(first);
+        Some(ticks as f64 / started.elapsed().as_secs_f64() / 1e6)
+    }
+    #[cfg(not(feature = "stage-clock"))]
+    {
+        None
+    }
+}
+
 /// Run alone (`cargo test -p pe --features stage-clock --lib stage_clock`, as CI does): the
 /// counts are the process's, and other tests stepping worlds at the same time would add
 /// theirs.
@@ -212,5 +231,13 @@ mod tests {
             let preparing = counts[Stage::Preparing as usize];
             assert!(parts_of(Some(Stage::Preparing)) <= preparing, "{counts:?}");
         }
+    }
+
+    /// The clock's rate is a processor's: between 0.1 and 10 GHz of time-stamp ticks (or
+    /// nanoseconds, 1 GHz).
+    #[test]
+    fn ticks_per_microsecond_is_a_clock_rate() {
+        let rate = ticks_per_microsecond().expect("the feature is on");
+        assert!((100.0..10_000.0).contains(&rate), "{rate}");
     }
 }
