@@ -351,7 +351,9 @@ fn run_stages_beside_box2d() {
                 .collect(),
         )
     };
-    let box2d_time = |fields: &dyn Fn(&boxdd::Profile) -> f32| {
+    // (what, pe's stages, Box2D v3's fields and their names)
+    type Fields = fn(&boxdd::Profile) -> f32;
+    let box2d_time = |fields: Fields| {
         median(
             box2d[from..]
                 .iter()
@@ -359,8 +361,6 @@ fn run_stages_beside_box2d() {
                 .collect(),
         )
     };
-    // (what, pe's stages, Box2D v3's fields and their names)
-    type Fields = fn(&boxdd::Profile) -> f32;
     let rows: [(&str, &[Stage], Fields, &str); 8] = [
         (
             "broad phase",
@@ -411,7 +411,7 @@ fn run_stages_beside_box2d() {
             "bullets (other fast bodies: in transforms)",
         ),
     ];
-    let whole = (pe_time(&[Stage::Step]), box2d_time(&|p| p.step));
+    let whole = (pe_time(&[Stage::Step]), box2d_time(|p| p.step));
     println!(
         "{scene} under pe soft: {pe_run:?}\n\n{scene} over {} steps from step {from}, \
          median microseconds a step (the stage clock at {ticks_per_microsecond:.0} ticks \
@@ -420,28 +420,22 @@ fn run_stages_beside_box2d() {
     );
     println!("| stage | pe soft | Box2D v3 | pe − Box2D v3 | Box2D v3's fields |");
     println!("| --- | ---: | ---: | ---: | --- |");
-    let mut parts = (0.0, 0.0);
-    for (name, stages, fields, field_names) in rows {
-        let (pe, b2) = (pe_time(stages), box2d_time(&fields));
-        parts = (parts.0 + pe, parts.1 + b2);
+    let print_row = |name: &str, (pe, b2): (f64, f64), field_names: &str| {
         println!(
             "| {name} | {pe:.0} | {b2:.0} | {:+.0} | {field_names} |",
             pe - b2
         );
+    };
+    let mut parts = (0.0, 0.0);
+    for (name, stages, fields, field_names) in rows {
+        let (pe, b2) = (pe_time(stages), box2d_time(fields));
+        parts = (parts.0 + pe, parts.1 + b2);
+        print_row(name, (pe, b2), field_names);
     }
     let rest = (whole.0 - parts.0, whole.1 - parts.1);
-    println!(
-        "| the rest (whole step less the medians above) | {:.0} | {:.0} | {:+.0} | step less the above |",
-        rest.0,
-        rest.1,
-        rest.0 - rest.1
-    );
-    println!(
-        "| whole step | {:.0} | {:.0} | {:+.0} | step |",
-        whole.0,
-        whole.1,
-        whole.0 - whole.1
-    );
+    let rest_name = "the rest (whole step less the medians above)";
+    print_row(rest_name, rest, "step less the above");
+    print_row("whole step", whole, "step");
 }
 
 /// The scenes of `pile`: every pile, the joint grid and the smash.
