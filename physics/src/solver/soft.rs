@@ -18,6 +18,7 @@ use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
 use batch::{AskedFor, LaneBatch, LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 use pins::{PinPass, PinPlan};
+use std::ops::Range;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -399,6 +400,11 @@ pub struct SoftStepSolver {
     rotations: Vec<Option<Rot>>,
     /// `joints` indices of the pins with a motor, in `joints`' order.
     motor_joints: Vec<u32>,
+    /// By body, whether a pin joins it (empty if there are no pins): such a body's
+    /// island is solved with the rest, not in a chunk (`PassPlan::assign_chunks`).
+    pinned: Vec<bool>,
+    /// The moving bodies of the chunk being solved.
+    chunk_bodies: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
@@ -522,6 +528,40 @@ fn rotate_delta(q: Rot, r: Vec2) -> Vec2 {
     q.apply(r)
 }
 
+/// A contact pass's settings for substeps of `h`.
+fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool) -> PassSettings {
+    PassSettings {
+        inv_h: 1.0 / h,
+        soft: *soft,
+        max_push: settings.max_push_speed,
+        use_bias,
+    }
+}
+
+/// A moving body's velocity over a substep of `h`.
+fn integrate_velocity(b: &mut SoftBody, (linear, angular): (Vec2, f64), h: f64) {
+    b.v += linear * h;
+    b.w += angular * h;
+    // A body turning more than a quarter turn per substep is beyond what the linearised
+    // rotation below (and any contact found at the step's start) can follow; like Box2D,
+    // cap the spin there rather than let it overflow to NaN.
+    let max_w = MAX_TURN_PER_SUBSTEP / h;
+    b.w = b.w.clamp(-max_w, max_w);
+}
+
+/// A body's motion since the step's start, over a substep of `h`.
+fn integrate_position(b: &mut SoftBody, h: f64) {
+    b.dp += b.v * h;
+    b.dangle += b.w * h;
+    // Rotate the delta rotation by ω·h and renormalise: no trigonometry per substep.
+    let (c, s) = (b.dq.cos - h * b.w * b.dq.sin, b.dq.sin + h * b.w * b.dq.cos);
+    let len = (c * c + s * s).sqrt();
+    b.dq = Rot {
+        cos: c / len,
+        sin: s / len,
+    };
+}
+
 impl SoftStepSolver {
     /// Advances `bodies` by `dt`: velocities from `accelerations` (linear, angular per
     /// body), constraints from `contacts` and `joints`, positions and angles integrated.
@@ -550,12 +590,44 @@ impl SoftStepSolver {
         let started = stage_clock::mark();
         self.prepare(bodies, accelerations, contacts, joints, dt);
         stage_clock::record(Stage::Preparing, started);
-        for _ in 0..settings.substeps {
-            let order = if settings.alternating_sweeps {
-                SweepOrder::of_substep(self.substeps_taken)
+        let sweep_order = |substep: u64| {
+            if settings.alternating_sweeps {
+                SweepOrder::of_substep(substep)
             } else {
                 SweepOrder::Forwards
-            };
+            }
+        };
+        // Chunks of islands first, each through every substep while its batches stay in
+        // the cache (`PassPlan::assign_chunks`), then the rest substep by substep.
+        let pass = |use_bias| contact_pass(h, &contact_soft, settings, use_bias);
+        for k in 0..self.plan.chunk_count() {
+            let (items, chunk_bodies) = self.plan.chunk(k);
+            self.chunk_bodies.clear();
+            self.chunk_bodies.extend_from_slice(chunk_bodies);
+            for substep in 0..settings.substeps {
+                let order = sweep_order(self.substeps_taken.wrapping_add(substep as u64));
+                for &i in &self.chunk_bodies {
+                    let i = i as usize;
+                    integrate_velocity(&mut self.bodies[i], accelerations[i], h);
+                }
+                let started = stage_clock::mark();
+                // The first substep's passes read the chunk's batches from farther out and
+                // ask for each next one (`BatchesAhead`); the later ones find them in the
+                // level-2 cache, where asking only costs (many_pyramids' solve 7% slower).
+                let ask = substep == 0;
+                self.warm_start_items(items.clone(), ask);
+                stage_clock::record(Stage::WarmStart, started);
+                let started = stage_clock::mark();
+                self.sweep_items(items.clone(), &pass(true), order, ask);
+                for &i in &self.chunk_bodies {
+                    integrate_position(&mut self.bodies[i as usize], h);
+                }
+                self.sweep_items(items.clone(), &pass(false), order, false);
+                stage_clock::record(Stage::Solve, started);
+            }
+        }
+        for _ in 0..settings.substeps {
+            let order = sweep_order(self.substeps_taken);
             self.substeps_taken = self.substeps_taken.wrapping_add(1);
             self.integrate_velocities(accelerations, h);
             let started = stage_clock::mark();
@@ -607,6 +679,14 @@ impl SoftStepSolver {
         // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
         // and at rest, and past the bodies `store` writes back.
         self.bodies.push(SoftBody::null());
+        self.pinned.clear();
+        if !joints.is_empty() {
+            self.pinned.resize(bodies.len(), false);
+            for j in joints {
+                self.pinned[j.body_a as usize] = true;
+                self.pinned[j.body_b as usize] = true;
+            }
+        }
         // The points are built island by island (each island's in the contacts' order):
         // grouping the contacts is cheaper than reordering the larger points afterwards.
         // A pile at rest has the same contacts between the same bodies step after step:
@@ -670,9 +750,11 @@ impl SoftStepSolver {
             !planned_first || (self.plan_inputs == self.planned_inputs && !self.may_bounce)
         );
         let kept = planned_first
-            || self
-                .plan
-                .read(&self.contact_lcp.all_islands, &self.plan_inputs);
+            || self.plan.read(
+                &self.contact_lcp.all_islands,
+                &self.plan_inputs,
+                &self.pinned,
+            );
         stage_clock::record(Stage::PreparingPlan, started);
         let rebuild = skipped && (!kept || self.may_bounce);
         #[cfg(test)]
@@ -819,8 +901,11 @@ impl SoftStepSolver {
         };
         self.contact_lcp
             .classify(&self.bodies, &self.contact_islands, ends);
-        self.plan
-            .read(&self.contact_lcp.all_islands, &self.planned_inputs);
+        self.plan.read(
+            &self.contact_lcp.all_islands,
+            &self.planned_inputs,
+            &self.pinned,
+        );
         self.plan.plan_before_points(contacts.len(), &self.bodies);
         true
     }
@@ -1085,32 +1170,24 @@ impl SoftStepSolver {
         island_ranges(grouped, &mut self.joint_islands);
     }
 
+    /// The rest's bodies' velocities (those no chunk moves).
     fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
-        for (b, (lin, ang)) in self.bodies.iter_mut().zip(accelerations) {
-            if !b.moves() {
-                continue;
+        let chunked = self.plan.chunk_count() > 0;
+        let bodies = self.bodies.iter_mut().zip(accelerations).enumerate();
+        for (i, (b, &acceleration)) in bodies {
+            if b.moves() && !(chunked && self.plan.in_chunk(i)) {
+                integrate_velocity(b, acceleration, h);
             }
-            b.v += lin * h;
-            b.w += ang * h;
-            // A body turning more than a quarter turn per substep is beyond what the
-            // linearised rotation below (and any contact found at the step's start) can
-            // follow; like Box2D, cap the spin there rather than let it overflow to NaN.
-            let max_w = MAX_TURN_PER_SUBSTEP / h;
-            b.w = b.w.clamp(-max_w, max_w);
         }
     }
 
+    /// The rest's bodies' positions (those no chunk moves).
     fn integrate_positions(&mut self, h: f64) {
-        for b in self.bodies.iter_mut() {
-            b.dp += b.v * h;
-            b.dangle += b.w * h;
-            // Rotate the delta rotation by ω·h and renormalise: no trigonometry per substep.
-            let (c, s) = (b.dq.cos - h * b.w * b.dq.sin, b.dq.sin + h * b.w * b.dq.cos);
-            let len = (c * c + s * s).sqrt();
-            b.dq = Rot {
-                cos: c / len,
-                sin: s / len,
-            };
+        let chunked = self.plan.chunk_count() > 0;
+        for (i, b) in self.bodies.iter_mut().enumerate() {
+            if !(chunked && self.plan.in_chunk(i)) {
+                integrate_position(b, h);
+            }
         }
     }
 
@@ -1126,25 +1203,7 @@ impl SoftStepSolver {
                 warm_start_point(&mut self.bodies, p);
             }
         }
-        let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
-        let lanes = LanePath::best();
-        let ahead = self.plan.batches_ahead();
-        ahead.visit(
-            self.plan.items.iter(),
-            AskedFor::WarmStart,
-            |item| match *item {
-                PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
-                PassItem::PointBatch(k) => {
-                    point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
-                }
-                PassItem::Manifold(first, count) => {
-                    let (first, count) = (first as usize, count as usize);
-                    for p in &self.points[first..first + count] {
-                        warm_start_point(&mut self.bodies, p);
-                    }
-                }
-            },
-        );
+        self.warm_start_items(self.plan.rest_items(), true);
         // Each pin's impulse and its motor's, pin by pin; the batched islands' pins, then
         // their motors'.
         for &(start, end) in &self.joint_islands {
@@ -1171,6 +1230,62 @@ impl SoftStepSolver {
         }
     }
 
+    /// Warm-starts the plan's `items`, in their order.
+    fn warm_start_items(&mut self, items: Range<usize>, ask: bool) {
+        let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
+        let lanes = LanePath::best();
+        let ahead = self.plan.batches_ahead().only_if(ask);
+        ahead.visit(
+            self.plan.items[items].iter(),
+            AskedFor::WarmStart,
+            |item| match *item {
+                PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
+                PassItem::PointBatch(k) => {
+                    point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
+                }
+                PassItem::Manifold(first, count) => {
+                    let (first, count) = (first as usize, count as usize);
+                    for p in &self.points[first..first + count] {
+                        warm_start_point(&mut self.bodies, p);
+                    }
+                }
+            },
+        );
+    }
+
+    /// One pass over the plan's `items`, in their order or backwards: eight manifolds at
+    /// a time where they are batched (see `batch`).
+    fn sweep_items(
+        &mut self,
+        items: Range<usize>,
+        pass: &PassSettings,
+        order: SweepOrder,
+        ask: bool,
+    ) {
+        let ahead = self.plan.batches_ahead().only_if(ask);
+        let (all_items, batches, point_batches) = self.plan.work();
+        let items = &all_items[items];
+        let lanes = LanePath::best();
+        let solve_item = |item: &PassItem| match *item {
+            PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, pass),
+            PassItem::PointBatch(k) => {
+                point_batches[k as usize].solve_on(lanes, &mut self.bodies, pass)
+            }
+            PassItem::Manifold(first, 2) => {
+                let i = first as usize;
+                let (first, second) = self.points.split_at_mut(i + 1);
+                solve_pair(&mut self.bodies, (&mut first[i], &mut second[0]), pass);
+            }
+            PassItem::Manifold(first, _) => {
+                solve_point(&mut self.bodies, &mut self.points[first as usize], pass)
+            }
+        };
+        match order {
+            SweepOrder::Forwards => ahead.visit(items.iter(), AskedFor::Pass, solve_item),
+            SweepOrder::Backwards => ahead.visit(items.iter().rev(), AskedFor::Pass, solve_item),
+        }
+    }
+
     fn solve(
         &mut self,
         h: f64,
@@ -1180,8 +1295,7 @@ impl SoftStepSolver {
         use_bias: bool,
         order: SweepOrder,
     ) {
-        let (max_push, joint_push) = (settings.max_push_speed, settings.joint_push_speed);
-        let inv_h = 1.0 / h;
+        let joint_push = settings.joint_push_speed;
         for &k in &self.motor_joints {
             solve_motor(&mut self.bodies, &mut self.joints[k as usize], h);
         }
@@ -1211,40 +1325,14 @@ impl SoftStepSolver {
             let j = &mut self.joints[k as usize];
             solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
         }
-        let pass = PassSettings {
-            inv_h,
-            soft: *contact_soft,
-            max_push,
-            use_bias,
-        };
+        let pass = contact_pass(h, contact_soft, settings, use_bias);
         self.contact_lcp
             .solve(&mut self.bodies, &mut self.points, &pass);
         // In the plan's order: small islands in the points' order, then big ones colour
         // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
-        let coloured_from = self.plan.coloured_from;
-        let ahead = self.plan.batches_ahead();
-        let (items, batches, point_batches) = self.plan.work();
-        let (small, coloured) = items.split_at(coloured_from);
-        let lanes = LanePath::best();
-        let mut solve_item = |item: &PassItem| match *item {
-            PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, &pass),
-            PassItem::PointBatch(k) => {
-                point_batches[k as usize].solve_on(lanes, &mut self.bodies, &pass)
-            }
-            PassItem::Manifold(first, 2) => {
-                let i = first as usize;
-                let (first, second) = self.points.split_at_mut(i + 1);
-                solve_pair(&mut self.bodies, (&mut first[i], &mut second[0]), &pass);
-            }
-            PassItem::Manifold(first, _) => {
-                solve_point(&mut self.bodies, &mut self.points[first as usize], &pass)
-            }
-        };
-        small.iter().for_each(&mut solve_item);
-        match order {
-            SweepOrder::Forwards => ahead.visit(coloured.iter(), AskedFor::Pass, solve_item),
-            SweepOrder::Backwards => ahead.visit(coloured.iter().rev(), AskedFor::Pass, solve_item),
-        }
+        let (rest, coloured_from) = (self.plan.rest_items(), self.plan.coloured_from);
+        self.sweep_items(0..coloured_from, &pass, SweepOrder::Forwards, true);
+        self.sweep_items(coloured_from..rest.end, &pass, order, true);
     }
 
     /// Restitution once, after the substeps, for contacts that were approaching faster
@@ -2174,6 +2262,65 @@ mod tests {
         let around = first.plan_inputs.iter().map(|p| p.first_and_count());
         let around: Vec<_> = around.filter(|&(k, _)| (22..28).contains(&k)).collect();
         assert_eq!(around, [(22, 2), (24, 1), (25, 1), (26, 2)]);
+    }
+
+    /// Coloured islands solved in chunks, each through every substep before the next
+    /// (`PassPlan::assign_chunks`), must move every body exactly as the whole step solved
+    /// substep by substep: the islands share no moving body. Four coloured columns, one
+    /// of them with two boxes pinned together (its island stays with the rest, whose pins
+    /// are solved with their contacts), a small column and a box alone (an LCP island),
+    /// through steps whose plan changes and steps that keep it.
+    #[test]
+    fn islands_solved_in_chunks_move_as_when_solved_together() {
+        let (bodies, whole) = columns(&[30, 30, 30, 30, 10, 1]);
+        // Without the first column's top box's contacts: the plan changes every other step.
+        let mut topless = whole.clone();
+        topless.drain(58..60);
+        // Boxes 95 and 96, in the fourth column, pinned at the corner they share.
+        let mut joints = [JointConstraint {
+            joint: 0,
+            body_a: 95,
+            body_b: 96,
+            local_anchor_a: Vec2::new(0.5, -0.5),
+            local_anchor_b: Vec2::new(0.5, 0.5),
+            motor: None,
+            gap_target: Vec2::zeros(),
+        }];
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let mut chunked = SoftStepSolver::default();
+        // Every island big enough in a chunk of its own.
+        chunked.plan.chunk_limits = Some((0, 0));
+        let mut together = SoftStepSolver::default();
+        together.plan.chunk_limits = Some((usize::MAX, 0));
+        let (mut bodies_chunked, mut bodies_together) = (bodies.clone(), bodies);
+        for k in 0..8 {
+            let contacts = [&whole, &topless][k / 2 % 2];
+            let mut step = |solver: &mut SoftStepSolver, bodies: &mut [SolverBody]| {
+                let mut contacts = contacts.to_vec();
+                let h = 1.0 / 60.0;
+                let a = &accelerations;
+                solver.step(&settings, bodies, a, &mut contacts, &mut joints, h, 1.0);
+                contacts
+            };
+            let contacts_chunked = step(&mut chunked, &mut bodies_chunked);
+            let contacts_together = step(&mut together, &mut bodies_together);
+            assert_eq!(
+                state_bits(&bodies_chunked, &contacts_chunked),
+                state_bits(&bodies_together, &contacts_together),
+                "step {k}"
+            );
+            // The three columns without a pin, a chunk each; none for the other solver.
+            assert_eq!(
+                (chunked.plan.chunk_count(), together.plan.chunk_count()),
+                (3, 0)
+            );
+        }
+        // The pinned island's boxes were moved by the rest's passes, the others' by the
+        // chunks'.
+        assert!(!chunked.plan.in_chunk(95) && !chunked.plan.in_chunk(96));
+        assert!(chunked.plan.in_chunk(0) && chunked.plan.in_chunk(31));
+        assert!(!chunked.plan.in_chunk(120) && !chunked.plan.in_chunk(130));
     }
 
     /// A step with a point that may bounce reads every point for its restitution, so it

@@ -59,6 +59,14 @@ const PREFETCH_AHEAD: usize = 16;
 /// 1–2%. The warm start asks for what it reads too.
 const ASK_AHEAD_FROM_BYTES: usize = 2 * 1024 * 1024;
 
+/// From how many bytes of batches a step solves its coloured islands in chunks
+/// (`PassPlan::assign_chunks`), and how many bytes of batches a chunk holds at most
+/// (unless one island alone is more). A chunk is solved through every substep before the
+/// next, so its batches are read from the level-2 cache (512 KB a core here) in all but
+/// the first pass, where the whole step's would come from the level 3 in every pass.
+const CHUNK_FROM_BYTES: usize = 1024 * 1024;
+const CHUNK_BYTES: usize = 256 * 1024;
+
 /// Where the step's batches lie (`PassPlan::batches_ahead`), kept apart from their
 /// borrow so that a pass holding them mutably can still ask for the next one. The
 /// pointers are only ever prefetched from, never read through.
@@ -77,6 +85,12 @@ pub(super) enum AskedFor {
 }
 
 impl BatchesAhead {
+    /// The same, asking only if `ask` too.
+    pub fn only_if(mut self, ask: bool) -> Self {
+        self.on &= ask;
+        self
+    }
+
     /// Hands `items` to `visit` in their order, asking for what `reader` will read of
     /// each next one's batch while the one before is visited.
     #[inline(always)]
@@ -168,6 +182,26 @@ pub(super) struct PassPlan {
     /// Where the coloured islands' items start in `items` (the small islands' come
     /// first, in the points' order).
     pub coloured_from: usize,
+    /// Where the chunks' items start in `items`, each chunk's after the last's (the items
+    /// before the first are the rest's), and where the last chunk's end (`assign_chunks`):
+    /// one entry, `items.len()`, if there are no chunks.
+    chunk_starts: Vec<usize>,
+    /// The moving bodies of each chunk, chunk after chunk, and where each chunk's start
+    /// (with the end of the last).
+    chunk_bodies: Vec<u32>,
+    chunk_body_starts: Vec<usize>,
+    /// By body, whether a chunk moves it (and so the rest's passes do not).
+    in_chunk: Vec<bool>,
+    /// The coloured islands (their ranges of `inputs`, and whether any of their bodies
+    /// carries a pin, which keeps the island out of the chunks), this step's and those
+    /// the last plan was made for.
+    coloured_islands: Vec<(u32, u32, bool)>,
+    last_coloured_islands: Vec<(u32, u32, bool)>,
+    /// Each input's chunk, counted from 1 (0: solved with the rest).
+    chunk_of_input: Vec<u32>,
+    /// Tests only: other bounds than `CHUNK_FROM_BYTES` and `CHUNK_BYTES`.
+    #[cfg(test)]
+    pub chunk_limits: Option<(usize, usize)>,
     /// Batches of two-point and of one-point manifolds.
     pairs: BatchPool<2>,
     singles: BatchPool<1>,
@@ -287,9 +321,16 @@ impl PassPlan {
     /// Reads this step's manifolds, `manifolds` in the points' order, grouped by `islands`
     /// (index ranges of the points, and whether the island is solved as one LCP: those
     /// are left out). Whether they are the last plan's: then `plan` keeps it.
-    pub fn read(&mut self, islands: &[(usize, usize, bool)], manifolds: &[PlanInput]) -> bool {
-        self.read_inputs(islands, manifolds);
-        self.kept_last_step = self.inputs == self.last_inputs;
+    /// `pinned` says, by body, whether a pin joins it (bodies past its end carry none).
+    pub fn read(
+        &mut self,
+        islands: &[(usize, usize, bool)],
+        manifolds: &[PlanInput],
+        pinned: &[bool],
+    ) -> bool {
+        self.read_inputs(islands, manifolds, pinned);
+        self.kept_last_step =
+            self.inputs == self.last_inputs && self.coloured_islands == self.last_coloured_islands;
         self.kept_last_step
     }
 
@@ -343,12 +384,14 @@ impl PassPlan {
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
         self.colour_in_scattered_order();
+        let chunks = self.assign_chunks();
         for k in 0..self.inputs.len() {
             let input = self.inputs[k];
             if input.flags & PlanInput::COLOURED != 0 {
-                // The sort key below: the colour, then sideways after upright.
+                // The sort key below: the chunk, the colour, then sideways after upright.
                 let sideways = u32::from(input.flags & PlanInput::SIDEWAYS != 0);
-                let key = 2 * self.colour_by_input[k] + sideways;
+                let class = self.chunk_of_input[k] * COLOURS + self.colour_by_input[k];
+                let key = 2 * class + sideways;
                 self.coloured.push(ColouredManifold {
                     key,
                     first: input.first,
@@ -370,7 +413,8 @@ impl PassPlan {
         // which takes the slower path (`solve_normals_together`): on the 40-row pyramid
         // at rest 332 of 2,400 batch passes a step, against 504 ungrouped.
         let key = |m: &ColouredManifold| m.key as usize;
-        let keys = 2 * COLOURS as usize; // colours 0..COLOURS (`colour_of`), two ways
+        // Colours 0..COLOURS (`colour_of`), two ways, in each of the rest and the chunks.
+        let keys = 2 * COLOURS as usize * (chunks as usize + 1);
         counting_sort(
             &self.coloured,
             keys,
@@ -382,10 +426,21 @@ impl PassPlan {
         // Two-point and one-point manifolds fill their own batches, colour by colour.
         let pad_from = LanePath::best().fewest_padded();
         let mut i = 0;
-        let colour_at = |coloured: &[ColouredManifold], i: usize| coloured[i].key / 2;
+        // The chunk and the colour.
+        let class_at = |coloured: &[ColouredManifold], i: usize| coloured[i].key / 2;
+        self.chunk_starts.clear();
+        self.chunk_bodies.clear();
+        self.chunk_body_starts.clear();
+        self.in_chunk.clear();
+        self.in_chunk.resize(bodies.len(), false);
         while i < self.coloured.len() {
-            let colour = colour_at(&self.coloured, i);
-            while i < self.coloured.len() && colour_at(&self.coloured, i) == colour {
+            let class = class_at(&self.coloured, i);
+            let (chunk, colour) = (class / COLOURS, class % COLOURS);
+            while self.chunk_starts.len() < chunk as usize {
+                self.chunk_starts.push(self.items.len());
+                self.chunk_body_starts.push(self.chunk_bodies.len());
+            }
+            while i < self.coloured.len() && class_at(&self.coloured, i) == class {
                 let ColouredManifold { first, count, .. } = self.coloured[i];
                 // Filling reads the points in colour order, scattered over the step's
                 // points (the smash's ~12 MB): they are asked for ahead.
@@ -396,6 +451,16 @@ impl PassPlan {
                     prefetch(std::slice::from_ref(&bodies[ahead.bodies.1 as usize]));
                 }
                 i += 1;
+                if chunk != 0 {
+                    let (a, b) = self.coloured[i - 1].bodies;
+                    for body in [a, b] {
+                        let b = body as usize;
+                        if bodies[b].moves() && !self.in_chunk[b] {
+                            self.in_chunk[b] = true;
+                            self.chunk_bodies.push(body);
+                        }
+                    }
+                }
                 let items = &mut self.items;
                 match (colour, count) {
                     (0, _) => items.push(PassItem::Manifold(first, count)),
@@ -408,7 +473,12 @@ impl PassPlan {
             self.singles
                 .end_colour((points, bodies), &mut self.items, pad_from);
         }
+        while self.chunk_starts.len() <= chunks as usize {
+            self.chunk_starts.push(self.items.len());
+            self.chunk_body_starts.push(self.chunk_bodies.len());
+        }
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
+        std::mem::swap(&mut self.coloured_islands, &mut self.last_coloured_islands);
         self.slot_of.clear();
         self.slot_of.resize(point_count, NO_SLOT);
         let pairs = self.pairs.filled().iter().map(|b| (true, &b.first_point));
@@ -469,8 +539,16 @@ impl PassPlan {
 
     /// The manifolds outside the LCP islands, each marked if its island is coloured,
     /// into `inputs`.
-    fn read_inputs(&mut self, islands: &[(usize, usize, bool)], manifolds: &[PlanInput]) {
+    fn read_inputs(
+        &mut self,
+        islands: &[(usize, usize, bool)],
+        manifolds: &[PlanInput],
+        pinned: &[bool],
+    ) {
         self.inputs.clear();
+        self.coloured_islands.clear();
+        let no_pins = pinned.is_empty();
+        let pinned = |body: u32| pinned.get(body as usize).copied().unwrap_or(false);
         let mut next = 0;
         for &(start, end, lcp) in islands {
             // The islands cover the points in order, so their manifolds follow each other.
@@ -485,6 +563,11 @@ impl PassPlan {
                 continue;
             }
             let coloured = if end - start >= MIN_COLOURED_ISLAND {
+                let island = &manifolds[from..next];
+                let has_pin = !no_pins && island.iter().any(|m| pinned(m.a) || pinned(m.b));
+                let at = self.inputs.len() as u32;
+                let range = (at, at + island.len() as u32, has_pin);
+                self.coloured_islands.push(range);
                 PlanInput::COLOURED
             } else {
                 0
@@ -495,6 +578,81 @@ impl PassPlan {
                     ..*m
                 }));
         }
+    }
+
+    /// Puts the coloured islands into chunks, into `chunk_of_input`, and returns how many
+    /// chunks there are. None if the coloured islands' batches are few enough to stay in
+    /// the cache (`CHUNK_FROM_BYTES`) or would all make one chunk; an island with a pin
+    /// stays with the rest, whose pins are solved with their contacts in every substep.
+    ///
+    /// The islands share no moving body, and each manifold's colour depends only on those
+    /// of its island coloured before it, so a chunk solved through all its substeps alone
+    /// gives each of its bodies the same operations in the same order as the whole step
+    /// solved substep by substep: the same bits.
+    fn assign_chunks(&mut self) -> u32 {
+        self.chunk_of_input.clear();
+        self.chunk_of_input.resize(self.inputs.len(), 0);
+        let inputs = &self.inputs;
+        let island_bytes = |&(from, to, _): &(u32, u32, bool)| -> usize {
+            let bytes = |m: &PlanInput| match m.count() {
+                2 => std::mem::size_of::<ManifoldBatch<2>>() / LANES,
+                _ => std::mem::size_of::<ManifoldBatch<1>>() / LANES,
+            };
+            inputs[from as usize..to as usize].iter().map(bytes).sum()
+        };
+        let (from_bytes, chunk_bytes) = (CHUNK_FROM_BYTES, CHUNK_BYTES);
+        #[cfg(test)]
+        let (from_bytes, chunk_bytes) = self.chunk_limits.unwrap_or((from_bytes, chunk_bytes));
+        let free = |island: &&(u32, u32, bool)| !island.2;
+        let total: usize = self
+            .coloured_islands
+            .iter()
+            .filter(free)
+            .map(island_bytes)
+            .sum();
+        if total < from_bytes {
+            return 0;
+        }
+        let (mut chunk, mut filled) = (1, 0);
+        for island in self.coloured_islands.iter().filter(free) {
+            let bytes = island_bytes(island);
+            if filled > 0 && filled + bytes > chunk_bytes {
+                chunk += 1;
+                filled = 0;
+            }
+            filled += bytes;
+            self.chunk_of_input[island.0 as usize..island.1 as usize].fill(chunk);
+        }
+        if chunk == 1 {
+            self.chunk_of_input.fill(0);
+            return 0;
+        }
+        chunk
+    }
+
+    /// How many chunks the coloured islands are solved in (`assign_chunks`).
+    pub fn chunk_count(&self) -> usize {
+        self.chunk_starts.len().saturating_sub(1)
+    }
+
+    /// The rest's items: every item but the chunks'.
+    pub fn rest_items(&self) -> std::ops::Range<usize> {
+        0..self
+            .chunk_starts
+            .first()
+            .copied()
+            .unwrap_or(self.items.len())
+    }
+
+    /// The items of chunk `k` (from 0), and its moving bodies.
+    pub fn chunk(&self, k: usize) -> (std::ops::Range<usize>, &[u32]) {
+        let bodies = &self.chunk_bodies[self.chunk_body_starts[k]..self.chunk_body_starts[k + 1]];
+        (self.chunk_starts[k]..self.chunk_starts[k + 1], bodies)
+    }
+
+    /// Whether a chunk moves `body` (then the rest's passes leave it).
+    pub fn in_chunk(&self, body: usize) -> bool {
+        self.in_chunk.get(body).copied().unwrap_or(false)
     }
 
     /// Writes what the passes changed in the batches back to their points.
@@ -1923,7 +2081,7 @@ pub(super) mod tests {
     /// `plan` over `points` as one island, from their entries (`inputs_of`).
     fn plan_one_island(plan: &mut PassPlan, points: &[PointConstraint], bodies: &[SoftBody]) {
         let inputs = inputs_of(points, bodies);
-        plan.read(&[(0, points.len(), false)], &inputs);
+        plan.read(&[(0, points.len(), false)], &inputs, &[]);
         plan.plan(points, bodies);
     }
 
@@ -2130,7 +2288,7 @@ pub(super) mod tests {
         assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
         let (bodies, points) = row_on_floor(10);
-        plan.read(&[(0, 38, false)], &inputs_of(&points, &bodies));
+        plan.read(&[(0, 38, false)], &inputs_of(&points, &bodies), &[]);
         plan.plan(&points, &bodies);
         let in_order: Vec<PassItem> = (0..19).map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
