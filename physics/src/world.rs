@@ -1467,7 +1467,15 @@ impl World {
         s.motion.clear();
         s.poses.clear();
         let margin = self.settings.contact_margin();
-        for (body, polygon) in self.bodies.iter().zip(s.polygons.iter_mut()) {
+        let is_fixed =
+            |body: &Option<Body>| body.as_ref().is_none_or(|b| b.is_static() || b.is_asleep());
+        // The grown bounds' pairs still hold every pair whose bounds overlap now if every
+        // body's bounds lie inside its grown ones, and the same bodies are fixed: checked
+        // as the bounds are made, in the one pass over the bodies.
+        let mut still_inside = s.fat_boxes.len() == self.bodies.len();
+        let mut same_fixed = s.fat_fixed.len() == self.bodies.len();
+        let bodies = self.bodies.iter().zip(s.polygons.iter_mut()).enumerate();
+        for (i, (body, polygon)) in bodies {
             // The speed of its farthest point from the spin alone.
             let spin = body
                 .as_ref()
@@ -1478,38 +1486,26 @@ impl World {
             s.motion.push((velocity * dt, spin * dt));
             let pose = body.as_ref().map_or(Pose::default(), Pose::of);
             s.poses.push(pose);
-            s.boxes.push(body.as_ref().map(|b| {
+            let bounds = body.as_ref().map(|b| {
                 // The outline from the pose (one rotation per body, shared with reuse).
                 polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
                 polygon.aabb().grown(0.5 * margin + reach)
-            }));
+            });
+            if still_inside {
+                still_inside = match (&bounds, &s.fat_boxes[i]) {
+                    (Some(now), Some(fat)) => fat.contains(now),
+                    (None, None) => true,
+                    _ => false,
+                };
+            }
+            same_fixed = same_fixed && s.fat_fixed[i] == is_fixed(body);
+            s.boxes.push(bounds);
         }
         let bodies = &self.bodies;
         // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
         // The broad phase leaves out such pairs only, not those of bodies held for one pass
         // of `auto` (whose two passes hold different bodies); those are dropped from its
         // pairs below, so that its pairs serve both passes.
-        let is_fixed = |i: usize| {
-            bodies[i]
-                .as_ref()
-                .is_none_or(|b| b.is_static() || b.is_asleep())
-        };
-        // The grown bounds' pairs still hold every pair whose bounds overlap now if every
-        // body's bounds lie inside its grown ones, and the same bodies are fixed.
-        let still_inside = s.fat_boxes.len() == s.boxes.len()
-            && s.boxes
-                .iter()
-                .zip(&s.fat_boxes)
-                .all(|(now, fat)| match (now, fat) {
-                    (Some(now), Some(fat)) => fat.contains(now),
-                    (None, None) => true,
-                    _ => false,
-                });
-        let same_fixed = s.fat_fixed.len() == bodies.len()
-            && s.fat_fixed
-                .iter()
-                .enumerate()
-                .all(|(i, &f)| f == is_fixed(i));
         if still_inside && same_fixed {
             s.paired_in_a_row = 0;
         } else {
@@ -1529,7 +1525,7 @@ impl World {
             s.fat_boxes
                 .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
             s.fat_fixed.clear();
-            s.fat_fixed.extend((0..bodies.len()).map(is_fixed));
+            s.fat_fixed.extend(bodies.iter().map(is_fixed));
             let (non_colliding, fixed) = (&self.non_colliding, &s.fat_fixed);
             let wanted = |i: usize, j: usize| {
                 let both_fixed = fixed[i] & fixed[j];
