@@ -2268,11 +2268,12 @@ mod tests {
     /// (`PassPlan::assign_chunks`), must move every body exactly as the whole step solved
     /// substep by substep: the islands share no moving body. Four coloured columns, one
     /// of them with two boxes pinned together (its island stays with the rest, whose pins
-    /// are solved with their contacts), a small column and a box alone (an LCP island),
-    /// through steps whose plan changes and steps that keep it.
+    /// are solved with their contacts), a taller one (too big for a chunk: with the rest
+    /// too), a small column and a box alone (an LCP island), through steps whose plan
+    /// changes and steps that keep it.
     #[test]
     fn islands_solved_in_chunks_move_as_when_solved_together() {
-        let (bodies, whole) = columns(&[30, 30, 30, 30, 10, 1]);
+        let (bodies, whole) = columns(&[30, 30, 30, 30, 40, 10, 1]);
         // Without the first column's top box's contacts: the plan changes every other step.
         let mut topless = whole.clone();
         topless.drain(58..60);
@@ -2289,8 +2290,9 @@ mod tests {
         let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
         let settings = SoftSettings::for_length_scale(1.0);
         let mut chunked = SoftStepSolver::default();
-        // Every island big enough in a chunk of its own.
-        chunked.plan.chunk_limits = Some((0, 0));
+        // Every coloured island in a chunk of its own: a chunk holds one column's batches.
+        let column = 30 * std::mem::size_of::<batch::ManifoldBatch<2>>() / lanes::LANES;
+        chunked.plan.chunk_limits = Some((0, column));
         let mut together = SoftStepSolver::default();
         together.plan.chunk_limits = Some((usize::MAX, 0));
         let (mut bodies_chunked, mut bodies_together) = (bodies.clone(), bodies);
@@ -2316,11 +2318,13 @@ mod tests {
                 (3, 0)
             );
         }
-        // The pinned island's boxes were moved by the rest's passes, the others' by the
-        // chunks'.
-        assert!(!chunked.plan.in_chunk(95) && !chunked.plan.in_chunk(96));
-        assert!(chunked.plan.in_chunk(0) && chunked.plan.in_chunk(31));
-        assert!(!chunked.plan.in_chunk(120) && !chunked.plan.in_chunk(130));
+        // The pinned island's boxes and the tall column's were moved by the rest's passes,
+        // the other columns' by the chunks'.
+        let in_chunk = |boxes: [usize; 2]| boxes.map(|i| chunked.plan.in_chunk(i));
+        assert_eq!(in_chunk([0, 31]), [true, true]);
+        assert_eq!(in_chunk([95, 96]), [false, false]);
+        assert_eq!(in_chunk([120, 159]), [false, false]);
+        assert_eq!(in_chunk([160, 170]), [false, false]);
     }
 
     /// A step with a point that may bounce reads every point for its restitution, so it

@@ -199,6 +199,8 @@ pub(super) struct PassPlan {
     last_coloured_islands: Vec<(u32, u32, bool)>,
     /// Each input's chunk, counted from 1 (0: solved with the rest).
     chunk_of_input: Vec<u32>,
+    /// Each coloured island's bytes of batches, 0 if it goes into no chunk.
+    island_bytes: Vec<usize>,
     /// Tests only: other bounds than `CHUNK_FROM_BYTES` and `CHUNK_BYTES`.
     #[cfg(test)]
     pub chunk_limits: Option<(usize, usize)>,
@@ -384,7 +386,7 @@ impl PassPlan {
         self.colours_of.clear();
         self.colours_of.resize(bodies.len(), 0);
         self.colour_in_scattered_order();
-        let chunks = self.assign_chunks();
+        let chunks = self.assign_chunks(bodies.len());
         for k in 0..self.inputs.len() {
             let input = self.inputs[k];
             if input.flags & PlanInput::COLOURED != 0 {
@@ -429,16 +431,11 @@ impl PassPlan {
         // The chunk and the colour.
         let class_at = |coloured: &[ColouredManifold], i: usize| coloured[i].key / 2;
         self.chunk_starts.clear();
-        self.chunk_bodies.clear();
-        self.chunk_body_starts.clear();
-        self.in_chunk.clear();
-        self.in_chunk.resize(bodies.len(), false);
         while i < self.coloured.len() {
             let class = class_at(&self.coloured, i);
             let (chunk, colour) = (class / COLOURS, class % COLOURS);
             while self.chunk_starts.len() < chunk as usize {
                 self.chunk_starts.push(self.items.len());
-                self.chunk_body_starts.push(self.chunk_bodies.len());
             }
             while i < self.coloured.len() && class_at(&self.coloured, i) == class {
                 let ColouredManifold { first, count, .. } = self.coloured[i];
@@ -451,16 +448,6 @@ impl PassPlan {
                     prefetch(std::slice::from_ref(&bodies[ahead.bodies.1 as usize]));
                 }
                 i += 1;
-                if chunk != 0 {
-                    let (a, b) = self.coloured[i - 1].bodies;
-                    for body in [a, b] {
-                        let b = body as usize;
-                        if bodies[b].moves() && !self.in_chunk[b] {
-                            self.in_chunk[b] = true;
-                            self.chunk_bodies.push(body);
-                        }
-                    }
-                }
                 let items = &mut self.items;
                 match (colour, count) {
                     (0, _) => items.push(PassItem::Manifold(first, count)),
@@ -475,7 +462,6 @@ impl PassPlan {
         }
         while self.chunk_starts.len() <= chunks as usize {
             self.chunk_starts.push(self.items.len());
-            self.chunk_body_starts.push(self.chunk_bodies.len());
         }
         std::mem::swap(&mut self.inputs, &mut self.last_inputs);
         std::mem::swap(&mut self.coloured_islands, &mut self.last_coloured_islands);
@@ -580,18 +566,28 @@ impl PassPlan {
         }
     }
 
-    /// Puts the coloured islands into chunks, into `chunk_of_input`, and returns how many
-    /// chunks there are. None if the coloured islands' batches are few enough to stay in
-    /// the cache (`CHUNK_FROM_BYTES`) or would all make one chunk; an island with a pin
-    /// stays with the rest, whose pins are solved with their contacts in every substep.
+    /// Puts the coloured islands into chunks (`chunk_of_input`, and each chunk's moving
+    /// bodies: `chunk_bodies`, `in_chunk`), and returns how many chunks there are.
+    ///
+    /// Only islands whose batches fit in a chunk (`CHUNK_BYTES`) go into one: a bigger one
+    /// would not stay in the cache through its substeps either. And only if those
+    /// islands' batches are many (`CHUNK_FROM_BYTES`), or else they stay in the cache
+    /// anyway, and only if they make more than one chunk. An island with a pin stays with
+    /// the rest, whose pins are solved with their contacts in every substep.
     ///
     /// The islands share no moving body, and each manifold's colour depends only on those
     /// of its island coloured before it, so a chunk solved through all its substeps alone
     /// gives each of its bodies the same operations in the same order as the whole step
     /// solved substep by substep: the same bits.
-    fn assign_chunks(&mut self) -> u32 {
+    fn assign_chunks(&mut self, body_count: usize) -> u32 {
         self.chunk_of_input.clear();
         self.chunk_of_input.resize(self.inputs.len(), 0);
+        self.chunk_bodies.clear();
+        self.chunk_body_starts.clear();
+        self.in_chunk.clear();
+        let (from_bytes, chunk_bytes) = (CHUNK_FROM_BYTES, CHUNK_BYTES);
+        #[cfg(test)]
+        let (from_bytes, chunk_bytes) = self.chunk_limits.unwrap_or((from_bytes, chunk_bytes));
         let inputs = &self.inputs;
         let island_bytes = |&(from, to, _): &(u32, u32, bool)| -> usize {
             let bytes = |m: &PlanInput| match m.count() {
@@ -600,31 +596,49 @@ impl PassPlan {
             };
             inputs[from as usize..to as usize].iter().map(bytes).sum()
         };
-        let (from_bytes, chunk_bytes) = (CHUNK_FROM_BYTES, CHUNK_BYTES);
-        #[cfg(test)]
-        let (from_bytes, chunk_bytes) = self.chunk_limits.unwrap_or((from_bytes, chunk_bytes));
-        let free = |island: &&(u32, u32, bool)| !island.2;
-        let total: usize = self
-            .coloured_islands
-            .iter()
-            .filter(free)
-            .map(island_bytes)
-            .sum();
-        if total < from_bytes {
+        self.island_bytes.clear();
+        self.island_bytes
+            .extend(self.coloured_islands.iter().map(|island| {
+                let bytes = island_bytes(island);
+                // An island that may not go into a chunk counts as none.
+                if island.2 || bytes > chunk_bytes {
+                    0
+                } else {
+                    bytes
+                }
+            }));
+        let total: usize = self.island_bytes.iter().sum();
+        if total < from_bytes.max(1) {
             return 0;
         }
-        let (mut chunk, mut filled) = (1, 0);
-        for island in self.coloured_islands.iter().filter(free) {
-            let bytes = island_bytes(island);
-            if filled > 0 && filled + bytes > chunk_bytes {
+        let (mut chunk, mut filled) = (0, chunk_bytes);
+        self.in_chunk.resize(body_count, false);
+        let islands = self.coloured_islands.iter().zip(&self.island_bytes);
+        for (&(from, to, _), &bytes) in islands.filter(|(_, bytes)| **bytes > 0) {
+            if filled + bytes > chunk_bytes {
                 chunk += 1;
                 filled = 0;
+                self.chunk_body_starts.push(self.chunk_bodies.len());
             }
             filled += bytes;
-            self.chunk_of_input[island.0 as usize..island.1 as usize].fill(chunk);
+            let (from, to) = (from as usize, to as usize);
+            self.chunk_of_input[from..to].fill(chunk);
+            for m in &self.inputs[from..to] {
+                let ends = [(m.a, PlanInput::A_MOVES), (m.b, PlanInput::B_MOVES)];
+                for (body, moves) in ends {
+                    if m.flags & moves != 0 && !self.in_chunk[body as usize] {
+                        self.in_chunk[body as usize] = true;
+                        self.chunk_bodies.push(body);
+                    }
+                }
+            }
         }
+        self.chunk_body_starts.push(self.chunk_bodies.len());
         if chunk == 1 {
             self.chunk_of_input.fill(0);
+            self.chunk_bodies.clear();
+            self.chunk_body_starts.clear();
+            self.in_chunk.clear();
             return 0;
         }
         chunk
