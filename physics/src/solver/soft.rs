@@ -405,6 +405,10 @@ pub struct SoftStepSolver {
     pinned: Vec<bool>,
     /// The moving bodies of the chunk being solved.
     chunk_bodies: Vec<u32>,
+    /// Whether a fixed body has a velocity this step (a static body the caller set moving):
+    /// its motion counts in every substep of the islands it touches, which a chunk solved
+    /// apart would not see, so the chunks are then solved with the rest.
+    a_fixed_body_moves: bool,
     /// `points` index ranges, one per island of contacts.
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
@@ -600,7 +604,7 @@ impl SoftStepSolver {
         // Chunks of islands first, each through every substep while its batches stay in
         // the cache (`PassPlan::assign_chunks`), then the rest substep by substep.
         let pass = |use_bias| contact_pass(h, &contact_soft, settings, use_bias);
-        for k in 0..self.plan.chunk_count() {
+        for k in 0..self.chunks_apart() {
             let (items, chunk_bodies) = self.plan.chunk(k);
             self.chunk_bodies.clear();
             self.chunk_bodies.extend_from_slice(chunk_bodies);
@@ -667,15 +671,22 @@ impl SoftStepSolver {
     ) {
         let started = stage_clock::mark();
         self.bodies.clear();
-        self.bodies.extend(bodies.iter().map(|b| SoftBody {
-            v: b.velocity,
-            w: b.angular_velocity,
-            inv_mass: b.inv_mass,
-            inv_inertia: b.inv_inertia,
-            dp: Vec2::zeros(),
-            dq: Rot { cos: 1.0, sin: 0.0 },
-            dangle: 0.0,
+        let mut a_fixed_body_moves = false;
+        self.bodies.extend(bodies.iter().map(|b| {
+            let fixed = b.inv_mass == 0.0 && b.inv_inertia == 0.0;
+            a_fixed_body_moves |=
+                fixed && (b.velocity != Vec2::zeros() || b.angular_velocity != 0.0);
+            SoftBody {
+                v: b.velocity,
+                w: b.angular_velocity,
+                inv_mass: b.inv_mass,
+                inv_inertia: b.inv_inertia,
+                dp: Vec2::zeros(),
+                dq: Rot { cos: 1.0, sin: 0.0 },
+                dangle: 0.0,
+            }
         }));
+        self.a_fixed_body_moves = a_fixed_body_moves;
         // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
         // and at rest, and past the bodies `store` writes back.
         self.bodies.push(SoftBody::null());
@@ -1170,9 +1181,29 @@ impl SoftStepSolver {
         island_ranges(grouped, &mut self.joint_islands);
     }
 
+    /// How many chunks this step solves apart, before the rest (`PassPlan::assign_chunks`).
+    /// None if a fixed body moves: then the rest's passes take the chunks' items too, in
+    /// their order, which solves every island as the chunks would.
+    fn chunks_apart(&self) -> usize {
+        if self.a_fixed_body_moves {
+            0
+        } else {
+            self.plan.chunk_count()
+        }
+    }
+
+    /// The rest's items: every item but those of the chunks solved apart.
+    fn rest_items(&self) -> Range<usize> {
+        if self.chunks_apart() > 0 {
+            self.plan.rest_items()
+        } else {
+            0..self.plan.items.len()
+        }
+    }
+
     /// The rest's bodies' velocities (those no chunk moves).
     fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
-        let chunked = self.plan.chunk_count() > 0;
+        let chunked = self.chunks_apart() > 0;
         let bodies = self.bodies.iter_mut().zip(accelerations).enumerate();
         for (i, (b, &acceleration)) in bodies {
             if b.moves() && !(chunked && self.plan.in_chunk(i)) {
@@ -1183,7 +1214,7 @@ impl SoftStepSolver {
 
     /// The rest's bodies' positions (those no chunk moves).
     fn integrate_positions(&mut self, h: f64) {
-        let chunked = self.plan.chunk_count() > 0;
+        let chunked = self.chunks_apart() > 0;
         for (i, b) in self.bodies.iter_mut().enumerate() {
             if !(chunked && self.plan.in_chunk(i)) {
                 integrate_position(b, h);
@@ -1203,7 +1234,7 @@ impl SoftStepSolver {
                 warm_start_point(&mut self.bodies, p);
             }
         }
-        self.warm_start_items(self.plan.rest_items(), true);
+        self.warm_start_items(self.rest_items(), true);
         // Each pin's impulse and its motor's, pin by pin; the batched islands' pins, then
         // their motors'.
         for &(start, end) in &self.joint_islands {
@@ -1330,7 +1361,7 @@ impl SoftStepSolver {
             .solve(&mut self.bodies, &mut self.points, &pass);
         // In the plan's order: small islands in the points' order, then big ones colour
         // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
-        let (rest, coloured_from) = (self.plan.rest_items(), self.plan.coloured_from);
+        let (rest, coloured_from) = (self.rest_items(), self.plan.coloured_from);
         self.sweep_items(0..coloured_from, &pass, SweepOrder::Forwards, true);
         self.sweep_items(coloured_from..rest.end, &pass, order, true);
     }
@@ -2270,7 +2301,9 @@ mod tests {
     /// of them with two boxes pinned together (its island stays with the rest, whose pins
     /// are solved with their contacts), a taller one (too big for a chunk: with the rest
     /// too), a small column and a box alone (an LCP island), through steps whose plan
-    /// changes and steps that keep it.
+    /// changes and steps that keep it; then with the floor moving (a fixed body
+    /// with a velocity, whose motion each island must see substep by substep: the chunks
+    /// are then solved with the rest).
     #[test]
     fn islands_solved_in_chunks_move_as_when_solved_together() {
         let (bodies, whole) = columns(&[30, 30, 30, 30, 40, 10, 1]);
@@ -2295,9 +2328,15 @@ mod tests {
         chunked.plan.chunk_limits = Some((0, column));
         let mut together = SoftStepSolver::default();
         together.plan.chunk_limits = Some((usize::MAX, 0));
+        let floor = bodies.len() - 1;
         let (mut bodies_chunked, mut bodies_together) = (bodies.clone(), bodies);
-        for k in 0..8 {
+        for k in 0..12 {
             let contacts = [&whole, &topless][k / 2 % 2];
+            let floor_moves = k >= 8;
+            if floor_moves {
+                bodies_chunked[floor].velocity = Vec2::new(0.3, 0.2);
+                bodies_together[floor].velocity = Vec2::new(0.3, 0.2);
+            }
             let mut step = |solver: &mut SoftStepSolver, bodies: &mut [SolverBody]| {
                 let mut contacts = contacts.to_vec();
                 let h = 1.0 / 60.0;
@@ -2312,10 +2351,16 @@ mod tests {
                 state_bits(&bodies_together, &contacts_together),
                 "step {k}"
             );
-            // The three columns without a pin, a chunk each; none for the other solver.
+            // The three columns without a pin, a chunk each, solved apart while the floor
+            // stands; none for the other solver.
             assert_eq!(
                 (chunked.plan.chunk_count(), together.plan.chunk_count()),
                 (3, 0)
+            );
+            let apart = if floor_moves { 0 } else { 3 };
+            assert_eq!(
+                (chunked.chunks_apart(), together.chunks_apart()),
+                (apart, 0)
             );
         }
         // The pinned island's boxes and the tall column's were moved by the rest's passes,
