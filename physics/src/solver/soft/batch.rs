@@ -60,10 +60,11 @@ const PREFETCH_AHEAD: usize = 16;
 const ASK_AHEAD_FROM_BYTES: usize = 2 * 1024 * 1024;
 
 /// From how many bytes of batches a step solves its coloured islands in chunks
-/// (`PassPlan::assign_chunks`), and how many bytes of batches a chunk holds at most
-/// (unless one island alone is more). A chunk is solved through every substep before the
-/// next, so its batches are read from the level-2 cache (512 KB a core here) in all but
-/// the first pass, where the whole step's would come from the level 3 in every pass.
+/// (`PassPlan::assign_chunks`), and how many bytes of batches a chunk holds at most (an
+/// island with more stays with the rest). A chunk is solved through every substep before
+/// the next, so its batches are read from the level-2 cache (512 KB a core here) in all
+/// but the first pass, where the whole step's would come from the level 3 in every pass:
+/// many_pyramids' warm start a third cheaper, its solve a seventh (docs/bench/profile.md).
 const CHUNK_FROM_BYTES: usize = 1024 * 1024;
 const CHUNK_BYTES: usize = 256 * 1024;
 
@@ -611,11 +612,11 @@ impl PassPlan {
         if total < from_bytes.max(1) {
             return 0;
         }
-        let (mut chunk, mut filled) = (0, chunk_bytes);
+        let (mut chunk, mut filled) = (0, 0);
         self.in_chunk.resize(body_count, false);
         let islands = self.coloured_islands.iter().zip(&self.island_bytes);
         for (&(from, to, _), &bytes) in islands.filter(|(_, bytes)| **bytes > 0) {
-            if filled + bytes > chunk_bytes {
+            if chunk == 0 || filled + bytes > chunk_bytes {
                 chunk += 1;
                 filled = 0;
                 self.chunk_body_starts.push(self.chunk_bodies.len());
