@@ -403,8 +403,6 @@ pub struct SoftStepSolver {
     /// By body, whether a pin joins it (empty if there are no pins): such a body's
     /// island is solved with the rest, not in a chunk (`PassPlan::assign_chunks`).
     pinned: Vec<bool>,
-    /// The moving bodies of the chunk being solved.
-    chunk_bodies: Vec<u32>,
     /// Whether a fixed body has a velocity this step (a static body the caller set moving):
     /// its motion counts in every substep of the islands it touches, which a chunk solved
     /// apart would not see, so the chunks are then solved with the rest.
@@ -605,12 +603,10 @@ impl SoftStepSolver {
         // the cache (`PassPlan::assign_chunks`), then the rest substep by substep.
         let pass = |use_bias| contact_pass(h, &contact_soft, settings, use_bias);
         for k in 0..self.chunks_apart() {
-            let (items, chunk_bodies) = self.plan.chunk(k);
-            self.chunk_bodies.clear();
-            self.chunk_bodies.extend_from_slice(chunk_bodies);
+            let items = self.plan.chunk(k).0;
             for substep in 0..settings.substeps {
                 let order = sweep_order(self.substeps_taken.wrapping_add(substep as u64));
-                for &i in &self.chunk_bodies {
+                for &i in self.plan.chunk(k).1 {
                     let i = i as usize;
                     integrate_velocity(&mut self.bodies[i], accelerations[i], h);
                 }
@@ -623,7 +619,7 @@ impl SoftStepSolver {
                 stage_clock::record(Stage::WarmStart, started);
                 let started = stage_clock::mark();
                 self.sweep_items(items.clone(), &pass(true), order, ask);
-                for &i in &self.chunk_bodies {
+                for &i in self.plan.chunk(k).1 {
                     integrate_position(&mut self.bodies[i as usize], h);
                 }
                 self.sweep_items(items.clone(), &pass(false), order, false);
@@ -673,10 +669,7 @@ impl SoftStepSolver {
         self.bodies.clear();
         let mut a_fixed_body_moves = false;
         self.bodies.extend(bodies.iter().map(|b| {
-            let fixed = b.inv_mass == 0.0 && b.inv_inertia == 0.0;
-            a_fixed_body_moves |=
-                fixed && (b.velocity != Vec2::zeros() || b.angular_velocity != 0.0);
-            SoftBody {
+            let body = SoftBody {
                 v: b.velocity,
                 w: b.angular_velocity,
                 inv_mass: b.inv_mass,
@@ -684,7 +677,9 @@ impl SoftStepSolver {
                 dp: Vec2::zeros(),
                 dq: Rot { cos: 1.0, sin: 0.0 },
                 dangle: 0.0,
-            }
+            };
+            a_fixed_body_moves |= !body.moves() && (body.v != Vec2::zeros() || body.w != 0.0);
+            body
         }));
         self.a_fixed_body_moves = a_fixed_body_moves;
         // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
