@@ -42,7 +42,9 @@ const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 /// Islands of fewer contact points than this are solved in the points' order, one
 /// manifold at a time: below it, colouring costs more than the batches save (a pyramid of
 /// 3 rows, ~30 points: 2% more instructions per step coloured; of 4 rows, ~50 points: 12%
-/// fewer).
+/// fewer). Unless the small islands together have this many points: the colours are
+/// shared by every island, so that many small ones fill the lanes together (the smash's
+/// debris: its solve a third cheaper coloured, docs/bench/profile.md).
 const MIN_COLOURED_ISLAND: usize = 48;
 
 /// How many manifolds ahead of the one batched now `plan` asks the cache for the points
@@ -536,6 +538,12 @@ impl PassPlan {
         self.coloured_islands.clear();
         let no_pins = pinned.is_empty();
         let pinned = |body: u32| pinned.get(body as usize).copied().unwrap_or(false);
+        let small_points: usize = islands
+            .iter()
+            .filter(|&&(start, end, lcp)| !lcp && end - start < MIN_COLOURED_ISLAND)
+            .map(|&(start, end, _)| end - start)
+            .sum();
+        let small_ones_coloured = small_points >= MIN_COLOURED_ISLAND;
         let mut next = 0;
         for &(start, end, lcp) in islands {
             // The islands cover the points in order, so their manifolds follow each other.
@@ -549,7 +557,7 @@ impl PassPlan {
             if lcp {
                 continue;
             }
-            let coloured = if end - start >= MIN_COLOURED_ISLAND {
+            let coloured = if small_ones_coloured || end - start >= MIN_COLOURED_ISLAND {
                 let island = &manifolds[from..next];
                 let has_pin = !no_pins && island.iter().any(|m| pinned(m.a) || pinned(m.b));
                 let at = self.inputs.len() as u32;
@@ -2306,6 +2314,33 @@ pub(super) mod tests {
         plan.read(&[(0, 38, false)], &inputs_of(&points, &bodies), &[]);
         plan.plan(&points, &bodies);
         let in_order: Vec<PassItem> = (0..19).map(|m| PassItem::Manifold(2 * m, 2)).collect();
+        assert_eq!(plan.items, in_order);
+    }
+
+    #[test]
+    fn small_islands_are_coloured_together_once_their_points_make_a_big_ones() {
+        // 27 two-point manifolds, taken as islands of 18 points (9 manifolds) each.
+        let (bodies, points) = row_on_floor(14);
+        let inputs = inputs_of(&points, &bodies);
+        let islands = |lcp_middle| [(0, 18, false), (18, 36, lcp_middle), (36, 54, false)];
+        let mut plan = PassPlan::default();
+        plan.read(&islands(false), &inputs, &[]);
+        plan.plan(&points, &bodies);
+        assert_eq!(plan.coloured_from, 0, "every manifold coloured");
+        let lanes = |b: &ManifoldBatch<2>| b.first_point.iter().filter(|&&f| f != PAD).count();
+        let batched: usize = plan.batches().iter().map(lanes).sum();
+        let alone = plan
+            .items
+            .iter()
+            .filter(|i| matches!(i, PassItem::Manifold(..)));
+        assert_eq!(batched + alone.count(), 27);
+        assert!(batched >= 16, "{batched} of 27 manifolds in batches");
+        // With the middle one an LCP island, the other two have 36 points: each solved
+        // in the points' order.
+        plan.read(&islands(true), &inputs, &[]);
+        plan.plan(&points, &bodies);
+        let ends = (0..9).chain(18..27);
+        let in_order: Vec<PassItem> = ends.map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
     }
 }
