@@ -2301,7 +2301,7 @@ mod tests {
     /// are then solved with the rest).
     #[test]
     fn islands_solved_in_chunks_move_as_when_solved_together() {
-        let (bodies, whole) = columns(&[30, 30, 30, 30, 40, 10, 1]);
+        let (bodies, whole) = columns(&[30, 30, 30, 30, 40, 2, 1]);
         // Without the first column's top box's contacts: the plan changes every other step.
         let mut topless = whole.clone();
         topless.drain(58..60);
@@ -2389,8 +2389,8 @@ mod tests {
     /// grouping.
     #[test]
     fn contacts_on_other_bodies_are_grouped_again() {
-        // A column of 30 boxes (60 points: coloured into batches), one of 10 (20 points:
-        // solved point by point) and a box alone (an LCP island).
+        // A column of 30 boxes (60 points), one of 10 (20 points), both coloured into
+        // batches, and a box alone (an LCP island).
         let (bodies, standing) = columns(&[30, 10, 1]);
         // Box 35 on box 20 instead of box 34: the two columns' islands change.
         let mut moved = standing.clone();

@@ -40,12 +40,13 @@ const COLOURS: u32 = 32;
 const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 
 /// Islands of fewer contact points than this are solved in the points' order, one
-/// manifold at a time: below it, colouring costs more than the batches save (a pyramid of
-/// 3 rows, ~30 points: 2% more instructions per step coloured; of 4 rows, ~50 points: 12%
-/// fewer). Unless the small islands together have this many points: the colours are
-/// shared by every island, so that many small ones fill the lanes together (the smash's
-/// debris: its solve a third cheaper coloured, docs/bench/profile.md).
-const MIN_COLOURED_ISLAND: usize = 48;
+/// manifold at a time: below it, the lanes would stay nearly empty. Unless the small
+/// islands together have this many points, since the colours are shared by every island
+/// and many small ones fill the lanes together (the smash's debris). Coloured, a lone
+/// stack of 2 boxes (4 points) costs the same a step, of 5 boxes 4% less, of 10 boxes
+/// 39% less; three stacks of 2 boxes 30% less (docs/bench/profile.md, "Small islands
+/// coloured"; this was 48, from instructions counted rather than time).
+const MIN_COLOURED_ISLAND: usize = 8;
 
 /// How many manifolds ahead of the one batched now `plan` asks the cache for the points
 /// and bodies of.
@@ -2310,21 +2311,21 @@ pub(super) mod tests {
         assert_ne!(plan.items, kept);
         assert_eq!(plan.items, fresh.items);
         // A small island keeps the points' order and is not batched.
-        let (bodies, points) = row_on_floor(10);
-        plan.read(&[(0, 38, false)], &inputs_of(&points, &bodies), &[]);
+        let (bodies, points) = row_on_floor(2);
+        plan.read(&[(0, 6, false)], &inputs_of(&points, &bodies), &[]);
         plan.plan(&points, &bodies);
-        let in_order: Vec<PassItem> = (0..19).map(|m| PassItem::Manifold(2 * m, 2)).collect();
+        let in_order: Vec<PassItem> = (0..3).map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
     }
 
     #[test]
     fn small_islands_are_coloured_together_once_their_points_make_a_big_ones() {
-        // 27 two-point manifolds, taken as islands of 18 points (9 manifolds) each.
+        // 27 two-point manifolds, taken as nine islands of 6 points (3 manifolds) each.
         let (bodies, points) = row_on_floor(14);
         let inputs = inputs_of(&points, &bodies);
-        let islands = |lcp_middle| [(0, 18, false), (18, 36, lcp_middle), (36, 54, false)];
+        let islands: Vec<_> = (0..9).map(|k| (6 * k, 6 * k + 6, false)).collect();
         let mut plan = PassPlan::default();
-        plan.read(&islands(false), &inputs, &[]);
+        plan.read(&islands, &inputs, &[]);
         plan.plan(&points, &bodies);
         assert_eq!(plan.coloured_from, 0, "every manifold coloured");
         let lanes = |b: &ManifoldBatch<2>| b.first_point.iter().filter(|&&f| f != PAD).count();
@@ -2335,12 +2336,16 @@ pub(super) mod tests {
             .filter(|i| matches!(i, PassItem::Manifold(..)));
         assert_eq!(batched + alone.count(), 27);
         assert!(batched >= 16, "{batched} of 27 manifolds in batches");
-        // With the middle one an LCP island, the other two have 36 points: each solved
-        // in the points' order.
-        plan.read(&islands(true), &inputs, &[]);
-        plan.plan(&points, &bodies);
-        let ends = (0..9).chain(18..27);
-        let in_order: Vec<PassItem> = ends.map(|m| PassItem::Manifold(2 * m, 2)).collect();
+        // Two of them and an LCP island: 12 points, coloured. With the second an LCP
+        // island too, the first's 6 points are solved in their order.
+        let two = [(0, 6, false), (6, 12, false), (12, 18, true)];
+        plan.read(&two, &inputs[..9], &[]);
+        plan.plan(&points[..18], &bodies);
+        assert_eq!(plan.coloured_from, 0, "every manifold coloured");
+        let one = [(0, 6, false), (6, 12, true), (12, 18, true)];
+        plan.read(&one, &inputs[..9], &[]);
+        plan.plan(&points[..18], &bodies);
+        let in_order: Vec<PassItem> = (0..3).map(|m| PassItem::Manifold(2 * m, 2)).collect();
         assert_eq!(plan.items, in_order);
     }
 }
