@@ -2295,8 +2295,8 @@ mod tests {
     /// substep by substep: the islands share no moving body. Four coloured columns, one
     /// of them with two boxes pinned together (its island stays with the rest, whose pins
     /// are solved with their contacts), a taller one (too big for a chunk: with the rest
-    /// too), a small column and a box alone (an LCP island), through steps whose plan
-    /// changes and steps that keep it; then with the floor moving (a fixed body
+    /// too), a column of two boxes and a box alone (6 points together: solved one
+    /// manifold at a time), through steps whose plan changes and steps that keep it; then with the floor moving (a fixed body
     /// with a velocity, whose motion each island must see substep by substep: the chunks
     /// are then solved with the rest).
     #[test]
@@ -2390,7 +2390,7 @@ mod tests {
     #[test]
     fn contacts_on_other_bodies_are_grouped_again() {
         // A column of 30 boxes (60 points), one of 10 (20 points), both coloured into
-        // batches, and a box alone (an LCP island).
+        // batches, and a box alone (2 points, solved one manifold at a time).
         let (bodies, standing) = columns(&[30, 10, 1]);
         // Box 35 on box 20 instead of box 34: the two columns' islands change.
         let mut moved = standing.clone();

@@ -2319,7 +2319,7 @@ pub(super) mod tests {
     }
 
     #[test]
-    fn small_islands_are_coloured_together_once_their_points_make_a_big_ones() {
+    fn small_islands_are_coloured_together_once_they_have_enough_points() {
         // 27 two-point manifolds, taken as nine islands of 6 points (3 manifolds) each.
         let (bodies, points) = row_on_floor(14);
         let inputs = inputs_of(&points, &bodies);
