@@ -481,8 +481,31 @@ struct JointBlock {
     arms: Vec<(Vec2, Vec2)>,
     /// K, row-major, its lower triangle filled.
     k: Vec<f64>,
-    factor: EnvelopeCholesky,
     rhs: Vec<f64>,
+    /// This step's factor of each island's K, by island (`SoftStepSolver::joint_islands`).
+    factors: Vec<IslandFactor>,
+    /// Tests only: K factored in every pass, and how many times it was.
+    #[cfg(test)]
+    factor_every_pass: bool,
+    #[cfg(test)]
+    factored: usize,
+}
+
+/// An island's factor of K and the bits of the arms it was made from. K depends on the
+/// arms and on the bodies' masses, which a step does not change, and the arms only on the
+/// bodies' rotations: the relax pass of one substep and the biased pass of the next see
+/// the same rotations (velocities change between them, positions do not), so the second
+/// takes the first's factor, the same to the bit.
+#[derive(Debug, Clone, Default)]
+struct IslandFactor {
+    /// Empty if no factor was made this step.
+    arm_bits: Vec<[u64; 4]>,
+    factor: EnvelopeCholesky,
+}
+
+fn arm_bits(arms: &[(Vec2, Vec2)]) -> impl Iterator<Item = [u64; 4]> + '_ {
+    arms.iter()
+        .map(|(a, b)| [a.x, a.y, b.x, b.y].map(f64::to_bits))
 }
 
 /// The contacts' islands as `build_points` takes them: `(island, contact)` pairs
@@ -839,6 +862,7 @@ impl SoftStepSolver {
             });
         }
         self.group_joints();
+        self.block.begin_step(self.joint_islands.len());
         self.motor_joints.clear();
         let motors = self
             .joints
@@ -1325,16 +1349,20 @@ impl SoftStepSolver {
         for &k in &self.motor_joints {
             solve_motor(&mut self.bodies, &mut self.joints[k as usize], h);
         }
-        for &(start, end) in &self.joint_islands {
+        for (index, &(start, end)) in self.joint_islands.iter().enumerate() {
             let island = &mut self.joints[start..end];
             if PinPlan::batches_island(island.len()) {
                 continue;
             }
             // A lone pin's 2 × 2 is solved in closed form below.
             let solved = island.len() >= 2
-                && self
-                    .block
-                    .solve(&mut self.bodies, island, joint_soft, joint_push, use_bias);
+                && self.block.solve(
+                    &mut self.bodies,
+                    (index, island),
+                    joint_soft,
+                    joint_push,
+                    use_bias,
+                );
             if !solved {
                 for j in island.iter_mut() {
                     solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
@@ -1797,22 +1825,27 @@ fn pin_target(
 }
 
 impl JointBlock {
-    /// Solves one island's pins together: K ψ = −(Δv + bias) over all of them, then each
-    /// impulse softened as a lone pin's would be. False if K is not positive definite
-    /// (redundant pins), leaving the bodies untouched.
+    /// Starts a step of `islands` islands of pins: no factor made yet.
+    fn begin_step(&mut self, islands: usize) {
+        self.factors.resize_with(islands, IslandFactor::default);
+        for cached in &mut self.factors {
+            cached.arm_bits.clear();
+        }
+    }
+
+    /// Solves the pins of island `index` (`island`) together: K ψ = −(Δv + bias) over all
+    /// of them, then each impulse softened as a lone pin's would be. False if K is not
+    /// positive definite (redundant pins), leaving the bodies untouched.
     fn solve(
         &mut self,
         bodies: &mut [SoftBody],
-        island: &mut [SoftJoint],
+        (index, island): (usize, &mut [SoftJoint]),
         soft: &Softness,
         max_push: f64,
         use_bias: bool,
     ) -> bool {
-        let m = island.len();
-        let n = 2 * m;
+        let n = 2 * island.len();
         self.arms.clear();
-        self.k.clear();
-        self.k.resize(n * n, 0.0);
         self.rhs.clear();
         self.rhs.resize(n, 0.0);
         let (mut mass_scale, mut impulse_scale) = (1.0, 0.0);
@@ -1823,6 +1856,49 @@ impl JointBlock {
             self.rhs[2 * p] = -target.x;
             self.rhs[2 * p + 1] = -target.y;
         }
+        let cached = &self.factors[index];
+        let same_arms = cached.arm_bits.iter().copied().eq(arm_bits(&self.arms));
+        #[cfg(test)]
+        let same_arms = same_arms && !self.factor_every_pass;
+        if !same_arms {
+            #[cfg(test)]
+            {
+                self.factored += 1;
+            }
+            let mut factor = std::mem::take(&mut self.factors[index].factor);
+            let factored = self.factor(bodies, island, &mut factor);
+            let cached = &mut self.factors[index];
+            cached.factor = factor;
+            cached.arm_bits.clear();
+            if !factored {
+                return false;
+            }
+            cached.arm_bits.extend(arm_bits(&self.arms));
+        }
+        self.factors[index].factor.solve(&mut self.rhs);
+        let psi = &self.rhs;
+        for (p, j) in island.iter_mut().enumerate() {
+            let impulse =
+                Vec2::new(psi[2 * p], psi[2 * p + 1]) * mass_scale - j.impulse * impulse_scale;
+            j.impulse += impulse;
+            let (ra, rb) = self.arms[p];
+            SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);
+        }
+        true
+    }
+
+    /// Builds K for `island`'s pins at `self.arms` and factors it into `factor`: false if
+    /// it is not positive definite.
+    fn factor(
+        &mut self,
+        bodies: &[SoftBody],
+        island: &[SoftJoint],
+        factor: &mut EnvelopeCholesky,
+    ) -> bool {
+        let m = island.len();
+        let n = 2 * m;
+        self.k.clear();
+        self.k.resize(n * n, 0.0);
         for p in 0..m {
             for q in p..m {
                 // Pins with no body in common do not couple: their block stays zero (a
@@ -1846,22 +1922,11 @@ impl JointBlock {
         // bounded): a heavy chain's K is ill-conditioned but regular, and even that much
         // regularisation doubled its gap.
         let largest = (0..n).map(|i| self.k[i * n + i]).fold(0.0, f64::max);
-        if !self.factor.factor(&self.k, n, 1e-12 * largest) {
+        if !factor.factor(&self.k, n, 1e-12 * largest) {
             for i in 0..n {
                 self.k[i * n + i] += 1e-9 * largest;
             }
-            if !self.factor.factor(&self.k, n, 0.0) {
-                return false;
-            }
-        }
-        self.factor.solve(&mut self.rhs);
-        let psi = &self.rhs;
-        for (p, j) in island.iter_mut().enumerate() {
-            let impulse =
-                Vec2::new(psi[2 * p], psi[2 * p + 1]) * mass_scale - j.impulse * impulse_scale;
-            j.impulse += impulse;
-            let (ra, rb) = self.arms[p];
-            SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);
+            return factor.factor(&self.k, n, 0.0);
         }
         true
     }
@@ -2380,6 +2445,79 @@ mod tests {
         topless.drain(58..60);
         let (solver, _) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 6);
         assert_eq!(solver.steps_planned_first, 0);
+    }
+
+    /// A chain of `links` rods of 1 m along +x, pinned end to end and the first to a
+    /// fixed body at the origin.
+    fn rods(links: usize) -> (Vec<SolverBody>, Vec<JointConstraint>) {
+        let anchor = links as u32;
+        let mut bodies: Vec<SolverBody> = (0..links)
+            .map(|i| SolverBody {
+                position: Vec2::new(i as f64 + 0.5, 0.0),
+                inv_mass: 1.0,
+                inv_inertia: 12.0,
+                ..SolverBody::default()
+            })
+            .collect();
+        bodies.push(SolverBody::default());
+        let joints = (0..links)
+            .map(|i| JointConstraint {
+                joint: i as u32,
+                body_a: i as u32,
+                body_b: if i == 0 { anchor } else { i as u32 - 1 },
+                local_anchor_a: Vec2::new(-0.5, 0.0),
+                local_anchor_b: if i == 0 {
+                    Vec2::zeros()
+                } else {
+                    Vec2::new(0.5, 0.0)
+                },
+                motor: None,
+                gap_target: Vec2::zeros(),
+            })
+            .collect();
+        (bodies, joints)
+    }
+
+    /// An island of pins solved as one system factors its K only where its arms changed
+    /// (`IslandFactor`): the relax pass of one substep and the biased pass of the next
+    /// share a factor. The bodies must move as with K factored in every pass. A step
+    /// starts afresh: a chain hanging still has the same arms from step to step, to the
+    /// bit, and a mass changed between two steps must still reach its K.
+    #[test]
+    fn pins_factored_again_only_where_their_arms_changed_move_the_bodies_the_same() {
+        let settings = SoftSettings::for_length_scale(1.0);
+        let substeps = settings.substeps;
+        let steps = |gravity: Vec2, count: usize, every_pass: bool| {
+            let (mut bodies, mut joints) = rods(6);
+            let mut solver = SoftStepSolver::default();
+            solver.block.factor_every_pass = every_pass;
+            let gravity = vec![(gravity, 0.0); bodies.len()];
+            let mut bits = Vec::new();
+            for k in 0..count {
+                if k == count / 2 {
+                    bodies[3].inv_mass = 0.25;
+                }
+                let (mut contacts, h) = (Vec::new(), 1.0 / 60.0);
+                let (b, j) = (&mut bodies, &mut joints);
+                solver.step(&settings, b, &gravity, &mut contacts, j, h, 1.0);
+                bits.push(state_bits(&bodies, &[]));
+            }
+            (bits, solver.block.factored)
+        };
+        // Swinging down from level: every pass's arms are new but those after a relax pass.
+        let down = Vec2::new(0.0, 10.0);
+        let (shared, factored) = steps(down, 10, false);
+        let (every, factored_every) = steps(down, 10, true);
+        assert_eq!(shared, every);
+        assert_eq!(factored_every, 10 * 2 * substeps);
+        assert_eq!(factored, 10 * (substeps + 1));
+        // Pulled along its length, the chain hangs still: one factor a step, made afresh
+        // each step.
+        let along = Vec2::new(10.0, 0.0);
+        let (shared, factored) = steps(along, 4, false);
+        let (every, _) = steps(along, 4, true);
+        assert_eq!(shared, every);
+        assert_eq!(factored, 4);
     }
 
     /// A step whose contacts join other bodies than the last step's, as many of them and
