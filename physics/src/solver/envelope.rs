@@ -10,6 +10,9 @@ pub struct EnvelopeCholesky {
     n: usize,
     first: Vec<usize>,
     l: Vec<f64>,
+    /// 1 / L_ii: the substitutions multiply by these rather than divide, since each row's
+    /// division waits on the row before.
+    inverse_diagonal: Vec<f64>,
 }
 
 impl EnvelopeCholesky {
@@ -26,6 +29,7 @@ impl EnvelopeCholesky {
         if self.l.len() < n * n {
             self.l.resize(n * n, 0.0);
         }
+        self.inverse_diagonal.resize(n, 0.0);
         for i in 0..n {
             let first_i = self.first[i];
             for j in first_i..=i {
@@ -41,8 +45,9 @@ impl EnvelopeCholesky {
                         return false;
                     }
                     self.l[row_i + i] = sum.sqrt();
+                    self.inverse_diagonal[i] = 1.0 / self.l[row_i + i];
                 } else {
-                    self.l[row_i + j] = sum / self.l[row_j + j];
+                    self.l[row_i + j] = sum * self.inverse_diagonal[j];
                 }
             }
         }
@@ -61,13 +66,13 @@ impl EnvelopeCholesky {
             for (l, y) in self.l[row + first..row + i].iter().zip(&solved[first..]) {
                 sum -= l * y;
             }
-            rest[0] = sum / self.l[row + i];
+            rest[0] = sum * self.inverse_diagonal[i];
         }
         // Lᵀ x = y, from the last row up: x_i found, its column of Lᵀ (row i of L) is
         // taken out of the rows above.
         for i in (0..n).rev() {
             let (row, first) = (i * n, self.first[i]);
-            b[i] /= self.l[row + i];
+            b[i] *= self.inverse_diagonal[i];
             let x = b[i];
             for (y, l) in b[first..i].iter_mut().zip(&self.l[row + first..row + i]) {
                 *y -= l * x;
