@@ -2,13 +2,15 @@
 //! the factor L is nonzero only from the first nonzero of row i of K, so a matrix whose
 //! nonzeros hug the diagonal costs O(n · width²) instead of the dense O(n³). An island of
 //! pins numbered along its chain has a block-tridiagonal K; any other pattern still
-//! factors, at up to the dense cost.
+//! factors, at up to the dense cost. Only the envelope is stored.
 
-/// The factor L of K = L Lᵀ, row-major n × n, with each row's first nonzero column.
+/// The factor L of K = L Lᵀ, row by row within the envelope: row i holds columns
+/// `first[i]..=i`, from `l[start[i]]` on.
 #[derive(Debug, Clone, Default)]
 pub struct EnvelopeCholesky {
     n: usize,
     first: Vec<usize>,
+    start: Vec<usize>,
     l: Vec<f64>,
     /// 1 / L_ii: the substitutions multiply by these rather than divide, since each row's
     /// division waits on the row before.
@@ -25,33 +27,47 @@ impl EnvelopeCholesky {
         self.first.clear();
         self.first
             .extend((0..n).map(|i| (0..i).find(|&j| k[i * n + j] != 0.0).unwrap_or(i)));
-        // Only the envelope is written and read: the rest may hold an earlier factor.
-        if self.l.len() < n * n {
-            self.l.resize(n * n, 0.0);
+        self.start.clear();
+        let mut stored = 0;
+        for (i, &first) in self.first.iter().enumerate() {
+            self.start.push(stored);
+            stored += i + 1 - first;
         }
+        self.l.clear();
+        self.l.resize(stored, 0.0);
+        self.inverse_diagonal.clear();
         self.inverse_diagonal.resize(n, 0.0);
         for i in 0..n {
-            let first_i = self.first[i];
+            let (first_i, start_i) = (self.first[i], self.start[i]);
             for j in first_i..=i {
                 // Entries of rows i and j left of both rows' envelopes are zero.
-                let from = first_i.max(self.first[j]);
-                let (row_i, row_j) = (i * n, j * n);
-                let mut sum = k[row_i + j];
-                for m in from..j {
-                    sum -= self.l[row_i + m] * self.l[row_j + m];
+                let (first_j, start_j) = (self.first[j], self.start[j]);
+                let from = first_i.max(first_j);
+                let row_i = &self.l[start_i + from - first_i..start_i + j - first_i];
+                let row_j = &self.l[start_j + from - first_j..start_j + j - first_j];
+                let mut sum = k[i * n + j];
+                for (a, b) in row_i.iter().zip(row_j) {
+                    sum -= a * b;
                 }
+                let at = start_i + j - first_i;
                 if i == j {
                     if sum <= min_pivot || sum.is_nan() {
                         return false;
                     }
-                    self.l[row_i + i] = sum.sqrt();
-                    self.inverse_diagonal[i] = 1.0 / self.l[row_i + i];
+                    self.l[at] = sum.sqrt();
+                    self.inverse_diagonal[i] = 1.0 / self.l[at];
                 } else {
-                    self.l[row_i + j] = sum * self.inverse_diagonal[j];
+                    self.l[at] = sum * self.inverse_diagonal[j];
                 }
             }
         }
         true
+    }
+
+    /// Row i of L left of its diagonal, and the column it starts at.
+    fn left_of_diagonal(&self, i: usize) -> (&[f64], usize) {
+        let (first, start) = (self.first[i], self.start[i]);
+        (&self.l[start..start + i - first], first)
     }
 
     /// Solves K x = b in place with the last successful `factor`.
@@ -60,10 +76,10 @@ impl EnvelopeCholesky {
         debug_assert_eq!(b.len(), n);
         // L y = b, row by row.
         for i in 0..n {
-            let (row, first) = (i * n, self.first[i]);
+            let (row, first) = self.left_of_diagonal(i);
             let (solved, rest) = b.split_at_mut(i);
             let mut sum = rest[0];
-            for (l, y) in self.l[row + first..row + i].iter().zip(&solved[first..]) {
+            for (l, y) in row.iter().zip(&solved[first..]) {
                 sum -= l * y;
             }
             rest[0] = sum * self.inverse_diagonal[i];
@@ -71,10 +87,10 @@ impl EnvelopeCholesky {
         // Lᵀ x = y, from the last row up: x_i found, its column of Lᵀ (row i of L) is
         // taken out of the rows above.
         for i in (0..n).rev() {
-            let (row, first) = (i * n, self.first[i]);
             b[i] *= self.inverse_diagonal[i];
             let x = b[i];
-            for (y, l) in b[first..i].iter_mut().zip(&self.l[row + first..row + i]) {
+            let (row, first) = self.left_of_diagonal(i);
+            for (y, l) in b[first..i].iter_mut().zip(row) {
                 *y -= l * x;
             }
         }
@@ -121,6 +137,11 @@ mod tests {
             let b = DVector::from_fn(n, |_, _| lcg(&mut seed));
             let mut envelope = EnvelopeCholesky::default();
             assert!(envelope.factor(&k, n, 0.0));
+            if pattern == 1 {
+                // Only the band is stored: row i from column i − 3 (or 0) to i.
+                let band: usize = (0..n).map(|i| i - i.saturating_sub(3) + 1).sum();
+                assert_eq!(envelope.l.len(), band, "n {n}");
+            }
             let mut x: Vec<f64> = b.iter().copied().collect();
             envelope.solve(&mut x);
             let dense = a.clone().cholesky().unwrap().solve(&b);
