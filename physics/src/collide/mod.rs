@@ -141,6 +141,23 @@ impl Manifold {
         }
     }
 
+    /// A manifold of the first `len` of `points`, found against `reference_is_b`'s edge.
+    pub(crate) fn with_points(
+        (body_a, body_b): (BodyHandle, BodyHandle),
+        normal: Vec2,
+        (points, len): ([ContactPoint; 2], u8),
+        reference_is_b: bool,
+    ) -> Self {
+        Self {
+            body_a,
+            body_b,
+            normal,
+            points,
+            len,
+            reference_is_b,
+        }
+    }
+
     pub fn push(&mut self, point: ContactPoint) {
         if (self.len as usize) < self.points.len() {
             self.points[self.len as usize] = point;

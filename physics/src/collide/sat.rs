@@ -41,37 +41,59 @@ pub fn collide_polygons(
     let u = reference.normals[edge];
     // The normal points from B to A: the reference normal if B is the reference, else −u.
     let normal = if reference_is_b { u } else { -u };
-    let mut manifold = Manifold::new(handle_a, handle_b, normal);
-    manifold.reference_is_b = reference_is_b;
-    for (point, (reference_vertex, incident_vertex)) in
-        clipped_incident_points(reference, incident, edge)
-    {
-        let separation = u.dot(&(point - reference.vertices[edge]));
-        if separation <= margin {
-            let (vertex_a, vertex_b) = if reference_is_b {
-                (incident_vertex, reference_vertex)
-            } else {
-                (reference_vertex, incident_vertex)
-            };
-            manifold.push(ContactPoint {
-                position: point - u * (0.5 * separation),
-                depth: -separation,
-                id: end_id(vertex_a, vertex_b),
-            });
-        }
-    }
-    if manifold.points().is_empty() {
-        // Clipping can lose both points in a deep, skewed overlap: fall back to the
-        // incident vertex that reaches deepest past the reference edge.
-        let (k, separation) = deepest_vertex(incident, u, reference.vertices[edge]);
-        let role = if reference_is_b { 1 << 30 } else { 0 };
-        manifold.push(ContactPoint {
-            position: incident.vertices[k] - u * (0.5 * separation),
+    // The points are found as values and the manifold made once, at the end: pushed into
+    // a manifold made empty, and clipped through segments passed by value, each was
+    // stored in pieces and read back whole, which stalled the loads that forward stores
+    // (a third of this function's samples in the smash).
+    let mut ends = incident_edge(reference, incident, edge);
+    let r1 = reference.vertices[edge];
+    let r2 = reference.vertices[next_vertex(edge, reference.vertices.len())];
+    // The edge's direction, (r2 − r1)/|r2 − r1|: its normal turned back a quarter turn,
+    // the same quotients (`WorldPolygon::ensure_normals`) without another square root.
+    let tangent = Vec2::new(-u.y, u.x);
+    // Keep t·p ≥ t·r1, then t·p ≤ t·r2.
+    let kept =
+        clip(&mut ends, -tangent, -tangent.dot(&r1)) && clip(&mut ends, tangent, tangent.dot(&r2));
+    // Each end's point, and whether it lies within the margin.
+    let point_at = |end: &EdgeEnd| {
+        let separation = u.dot(&(end.point - r1));
+        let (vertex_a, vertex_b) = if reference_is_b {
+            (end.incident_vertex, end.reference_vertex)
+        } else {
+            (end.reference_vertex, end.incident_vertex)
+        };
+        let point = ContactPoint {
+            position: end.point - u * (0.5 * separation),
             depth: -separation,
-            id: FeatureId(1 << 31 | role | ((edge as u32) << 16) | k as u32),
-        });
-    }
-    Some(manifold)
+            id: end_id(vertex_a, vertex_b),
+        };
+        (point, kept && separation <= margin)
+    };
+    let ((first, first_kept), (second, second_kept)) = (point_at(&ends[0]), point_at(&ends[1]));
+    let none = ContactPoint::default();
+    let points = match (first_kept, second_kept) {
+        (true, true) => ([first, second], 2),
+        (true, false) => ([first, none], 1),
+        (false, true) => ([second, none], 1),
+        (false, false) => {
+            // Clipping can lose both points in a deep, skewed overlap: fall back to the
+            // incident vertex that reaches deepest past the reference edge.
+            let (k, separation) = deepest_vertex(incident, u, r1);
+            let role = if reference_is_b { 1 << 30 } else { 0 };
+            let deepest = ContactPoint {
+                position: incident.vertices[k] - u * (0.5 * separation),
+                depth: -separation,
+                id: FeatureId(1 << 31 | role | ((edge as u32) << 16) | k as u32),
+            };
+            ([deepest, none], 1)
+        }
+    };
+    Some(Manifold::with_points(
+        (handle_a, handle_b),
+        normal,
+        points,
+        reference_is_b,
+    ))
 }
 
 /// The edge of `p` whose outward normal separates `q` most, and that separation
@@ -182,16 +204,25 @@ fn end_id(vertex_a: u32, vertex_b: u32) -> FeatureId {
     FeatureId((vertex_a << 16) | vertex_b)
 }
 
-/// The incident edge (most anti-parallel to the reference normal) clipped to the side lines
-/// of the reference edge. Each point carries the vertices of the reference and the
-/// incident edge at its end (see `end_id`).
-fn clipped_incident_points(
-    reference: &WorldPolygon,
-    incident: &WorldPolygon,
-    edge: usize,
-) -> impl Iterator<Item = (Vec2, (u32, u32))> {
+/// One end of the incident edge as it is clipped: where it lies, and the vertices of the
+/// reference and of the incident edge at that end of the contact (see `end_id`).
+#[derive(Debug, Clone, Copy)]
+struct EdgeEnd {
+    point: Vec2,
+    reference_vertex: u32,
+    incident_vertex: u32,
+}
+
+/// The next vertex of a polygon of `n`, wrapped without the division of `%` (two per pair
+/// tested).
+fn next_vertex(i: usize, n: usize) -> usize {
+    if i + 1 == n { 0 } else { i + 1 }
+}
+
+/// The ends of the incident edge: `incident`'s edge most anti-parallel to the normal of
+/// `reference`'s edge `edge`.
+fn incident_edge(reference: &WorldPolygon, incident: &WorldPolygon, edge: usize) -> [EdgeEnd; 2] {
     let u = reference.normals[edge];
-    let n_inc = incident.vertices.len();
     let mut k = 0;
     let mut most_negative = f64::INFINITY;
     for (j, m) in incident.normals.iter().enumerate() {
@@ -201,41 +232,35 @@ fn clipped_incident_points(
             k = j;
         }
     }
-    // The next vertex, wrapped without the division of `%` (two per pair tested).
-    let next = |i: usize, n: usize| if i + 1 == n { 0 } else { i + 1 };
-    let edge2 = next(edge, reference.vertices.len());
-    let r1 = reference.vertices[edge];
-    let r2 = reference.vertices[edge2];
-    // The edge's direction, (r2 − r1)/|r2 − r1|: its normal turned back a quarter turn,
-    // the same quotients (`WorldPolygon::ensure_normals`) without another square root.
-    let tangent = Vec2::new(-u.y, u.x);
-    let k2 = next(k, n_inc);
-    let segment = [
-        (incident.vertices[k], (edge2 as u32, k as u32)),
-        (incident.vertices[k2], (edge as u32, k2 as u32)),
-    ];
-    // Keep t·p ≥ t·r1, then t·p ≤ t·r2.
-    let clipped =
-        clip(segment, -tangent, -tangent.dot(&r1)).and_then(|s| clip(s, tangent, tangent.dot(&r2)));
-    clipped.into_iter().flatten()
+    let edge2 = next_vertex(edge, reference.vertices.len());
+    let k2 = next_vertex(k, incident.vertices.len());
+    [
+        EdgeEnd {
+            point: incident.vertices[k],
+            reference_vertex: edge2 as u32,
+            incident_vertex: k as u32,
+        },
+        EdgeEnd {
+            point: incident.vertices[k2],
+            reference_vertex: edge as u32,
+            incident_vertex: k2 as u32,
+        },
+    ]
 }
 
-/// Keeps the part of a segment with `normal·p ≤ offset`; `None` if nothing is left. A cut
-/// end keeps its end's tag.
-fn clip<T: Copy>(segment: [(Vec2, T); 2], normal: Vec2, offset: f64) -> Option<[(Vec2, T); 2]> {
-    let d0 = normal.dot(&segment[0].0) - offset;
-    let d1 = normal.dot(&segment[1].0) - offset;
+/// Keeps the part of a segment with `normal·p ≤ offset`, in place: false if nothing is
+/// left. A cut end keeps its end's vertices.
+fn clip(ends: &mut [EdgeEnd; 2], normal: Vec2, offset: f64) -> bool {
+    let d0 = normal.dot(&ends[0].point) - offset;
+    let d1 = normal.dot(&ends[1].point) - offset;
     match (d0 <= 0.0, d1 <= 0.0) {
-        (true, true) => Some(segment),
-        (false, false) => None,
+        (true, true) => true,
+        (false, false) => false,
         (inside0, _) => {
             let t = d0 / (d0 - d1);
-            let cut = segment[0].0 + (segment[1].0 - segment[0].0) * t;
-            Some(if inside0 {
-                [segment[0], (cut, segment[1].1)]
-            } else {
-                [(cut, segment[0].1), segment[1]]
-            })
+            let cut = ends[0].point + (ends[1].point - ends[0].point) * t;
+            ends[usize::from(inside0)].point = cut;
+            true
         }
     }
 }
