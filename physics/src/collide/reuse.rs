@@ -73,7 +73,8 @@ struct CachedManifold {
 ///
 /// A pile at rest reuses every manifold of the last step, in order: this step's are then
 /// the first `kept_in_place` of `last`, and they are copied into `next` only once the
-/// step parts from them (a manifold stored afresh, or one of `last`'s left out).
+/// step parts from them (a new pair's manifold stored, or one of `last`'s left out); a
+/// pair found afresh replaces its own manifold there.
 #[derive(Debug, Clone, Default)]
 pub struct ManifoldCache {
     last: Vec<CachedManifold>,
@@ -197,8 +198,7 @@ impl ManifoldCache {
                 id: p.id,
             };
         }
-        self.part_from_last();
-        self.next.push(CachedManifold {
+        let stored = CachedManifold {
             pair: (manifold.body_a.0, manifold.body_b.0),
             relative: relative_pose(pose_a, pose_b),
             margin,
@@ -206,7 +206,24 @@ impl ManifoldCache {
             normal: reference.rotation.apply_inverse(u),
             points,
             len: manifold.points().len() as u8,
-        });
+        };
+        // A pair found afresh where its last manifold lies next among those kept in place
+        // replaces it there: a pile whose one base box creeps has that pair tested afresh
+        // every step, and parting there copied every manifold after it (large_pyramid:
+        // its first pair, then 15,000 manifolds of 144 bytes a step).
+        match &mut self.kept_in_place {
+            Some(kept)
+                if *kept == self.cursor
+                    && self.last.get(*kept).is_some_and(|c| c.pair == stored.pair) =>
+            {
+                self.last[*kept] = stored;
+                *kept += 1;
+            }
+            _ => {
+                self.part_from_last();
+                self.next.push(stored);
+            }
+        }
     }
 }
 
@@ -383,6 +400,46 @@ mod tests {
         cache.begin_step();
         cache.begin_step();
         assert!(reuse(&mut cache, (0, 1)).is_none());
+    }
+
+    /// A pair tested afresh whose last manifold is the next one kept in place replaces it
+    /// there: the step keeps its manifolds in place, and the next reuses the new one and
+    /// the rest.
+    #[test]
+    fn a_pair_found_afresh_replaces_its_last_manifold_in_place() {
+        let (poly_a, pose_a) = placed(&unit_square(), Vec2::zeros(), 0.0);
+        let (poly_b, pose_b) = placed(&unit_square(), Vec2::new(0.0, 0.999), 0.0);
+        let (margin, tie, tolerance) = (0.02, 0.001, 5e-4);
+        let wider = 2.0 * margin;
+        let manifold = |(i, j): (u32, u32), margin: f64| {
+            let (a, b) = ((BodyHandle(i), &poly_a), (BodyHandle(j), &poly_b));
+            collide_polygons(a, b, margin, tie).expect("in contact")
+        };
+        let reuse = |cache: &mut ManifoldCache, (i, j): (u32, u32), margin: f64| {
+            let found = (BodyHandle(i), &pose_a);
+            cache.reuse(found, (BodyHandle(j), &pose_b), margin, tolerance)
+        };
+        let pairs = [(0, 1), (0, 2), (1, 2)];
+        let mut cache = ManifoldCache::default();
+        for pair in pairs {
+            cache.store(&manifold(pair, margin), (&pose_a, &pose_b), margin);
+        }
+        cache.begin_step();
+        // The first pair's margin widens: refused, found afresh, stored where it was.
+        assert!(reuse(&mut cache, (0, 1), wider).is_none());
+        cache.store(&manifold((0, 1), wider), (&pose_a, &pose_b), wider);
+        assert_eq!(cache.kept_in_place, Some(1));
+        for pair in &pairs[1..] {
+            assert!(reuse(&mut cache, *pair, margin).is_some(), "{pair:?}");
+        }
+        assert_eq!(cache.kept_in_place, Some(3));
+        cache.begin_step();
+        let kept: Vec<_> = cache.last.iter().map(|c| (c.pair, c.margin)).collect();
+        assert_eq!(kept, [((0, 1), wider), ((0, 2), margin), ((1, 2), margin)]);
+        assert!(reuse(&mut cache, (0, 1), wider).is_some());
+        for pair in &pairs[1..] {
+            assert!(reuse(&mut cache, *pair, margin).is_some(), "{pair:?}");
+        }
     }
 
     /// The two other refusals: a margin wider than the cached manifold's (it may have left
