@@ -556,15 +556,6 @@ mod tests {
                 separation_beyond_vertex_by_vertex(&p, &q, floor, enough)
             );
         }
-    }
-
-    proptest::proptest! {
-        #![proptest_config(proptest::test_runner::Config {
-            cases: 2000,
-            rng_seed: proptest::test_runner::RngSeed::Fixed(2026),
-            failure_persistence: None,
-            ..proptest::test_runner::Config::default()
-        })]
 
         /// B's edges are searched only above what could replace A's best edge (or part
         /// them): the outcome is the full search's, each polygon's best edge over all of
