@@ -107,7 +107,7 @@ pub(super) fn max_separation(p: &WorldPolygon, q: &WorldPolygon) -> (usize, f64)
 /// apart, whichever edge separates most).
 fn separation_beyond(p: &WorldPolygon, q: &WorldPolygon, floor: f64, enough: f64) -> (usize, f64) {
     #[cfg(target_arch = "x86_64")]
-    if q.vertices.len() <= 4 {
+    if (1..=4).contains(&q.vertices.len()) {
         // SAFETY: SSE2 is part of the x86-64 baseline: every x86-64 processor has it.
         return unsafe { separation_beyond_of_four(p, q, floor, enough) };
     }
@@ -145,8 +145,8 @@ fn separation_beyond_vertex_by_vertex(
 /// over all of them at once in two pairs of lanes (SSE2, which every x86-64 has). A box's
 /// four vertices cost as much as one, where the scalar loop's early exit at each vertex
 /// went either way: the separating-axis loops were two fifths of `collide_polygons` in the
-/// smash. Each lane computes n·(w − v) as the scalar loop does, and a minimum is exact, so
-/// the separations, and the edge chosen, are the same to the bit.
+/// smash. Each lane computes n·(w − v) as the scalar loop does, and a minimum of finite
+/// numbers is exact, so the separations, and the edge chosen, are the same to the bit.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "sse2")]
 fn separation_beyond_of_four(
@@ -259,6 +259,7 @@ fn clip(ends: &mut [EdgeEnd; 2], normal: Vec2, offset: f64) -> bool {
         (inside0, _) => {
             let t = d0 / (d0 - d1);
             let cut = ends[0].point + (ends[1].point - ends[0].point) * t;
+            // The end outside moves to the cut.
             ends[usize::from(inside0)].point = cut;
             true
         }
