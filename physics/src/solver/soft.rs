@@ -1536,6 +1536,10 @@ fn approach(pair: &BodyPair, p: &mut PointConstraint, separation: f64) -> f64 {
 
 /// The velocities and inverse masses of a constraint's two bodies: a manifold's solve
 /// reads them once and writes them back once, instead of at every row.
+///
+/// A contact's rows add each product into the sum it feeds with one rounding
+/// (`f64::mul_add`), as the batches' lanes do (`Lanes::mul_add`): there a fused
+/// multiply–add is one instruction, and the passes' chains of dependent updates shorter.
 #[derive(Debug, Clone, Copy)]
 struct BodyPair {
     a: u32,
@@ -1576,7 +1580,10 @@ impl BodyPair {
     /// step) along `direction`, with the anchors' `levers` about it.
     #[inline(always)]
     fn velocity_along(&self, direction: Vec2, (lever_a, lever_b): (f64, f64)) -> f64 {
-        (self.va - self.vb).dot(&direction) + self.wa * lever_a - self.wb * lever_b
+        let r = self.va - self.vb;
+        let linear = r.y.mul_add(direction.y, r.x * direction.x);
+        let angular = (-self.wb).mul_add(lever_b, self.wa * lever_a);
+        linear + angular
     }
 
     /// A point's normal velocity.
@@ -1588,10 +1595,15 @@ impl BodyPair {
     /// `impulse` along `direction` on A and its opposite on B, with the anchors' levers.
     #[inline(always)]
     fn apply_along(&mut self, direction: Vec2, (lever_a, lever_b): (f64, f64), impulse: f64) {
-        self.va += direction * (impulse * self.inv_mass.0);
-        self.wa += self.inv_inertia.0 * lever_a * impulse;
-        self.vb -= direction * (impulse * self.inv_mass.1);
-        self.wb -= self.inv_inertia.1 * lever_b * impulse;
+        let (sa, sb) = (impulse * self.inv_mass.0, impulse * self.inv_mass.1);
+        self.va = Vec2::new(
+            direction.x.mul_add(sa, self.va.x),
+            direction.y.mul_add(sa, self.va.y),
+        );
+        self.wa = (self.inv_inertia.0 * lever_a).mul_add(impulse, self.wa);
+        let (nx, ny) = (-direction.x, -direction.y);
+        self.vb = Vec2::new(nx.mul_add(sb, self.vb.x), ny.mul_add(sb, self.vb.y));
+        self.wb = (-(self.inv_inertia.1 * lever_b)).mul_add(impulse, self.wb);
     }
 
     /// `impulse` on A at `r_a`, its opposite on B at `r_b`.
@@ -1625,10 +1637,11 @@ fn apply_normal(pair: &mut BodyPair, p: &mut PointConstraint, total: f64) {
 fn separation(a: &SoftBody, b: &SoftBody, p: &PointConstraint) -> f64 {
     // A body turned by q moves its anchor r by q·r − r, whose part along n is
     // (cos − 1)(r·n) + sin (r × n): the anchor's reach along the normal and its lever.
-    let turned = |q: Rot, reach: f64, lever: f64| (q.cos - 1.0) * reach + q.sin * lever;
+    let turned = |q: Rot, reach: f64, lever: f64| q.sin.mul_add(lever, (q.cos - 1.0) * reach);
     let (reach, lever) = (p.levers.reach, p.levers.normal);
-    (a.dp - b.dp).dot(&p.normal) + turned(a.dq, reach.0, lever.0) - turned(b.dq, reach.1, lever.1)
-        + p.base_separation
+    let d = a.dp - b.dp;
+    let moved = d.y.mul_add(p.normal.y, d.x * p.normal.x);
+    moved + turned(a.dq, reach.0, lever.0) - turned(b.dq, reach.1, lever.1) + p.base_separation
 }
 
 /// The velocity a point's normal row aims at (minus bias) and its softness, at
@@ -1679,7 +1692,8 @@ fn solve_normal(
     separation: f64,
 ) {
     let vn = approach(pair, p, separation);
-    let impulse = -p.normal_mass * mass_scale * (vn - target) - impulse_scale * p.normal_impulse;
+    let pushed = -p.normal_mass * mass_scale * (vn - target);
+    let impulse = (-impulse_scale).mul_add(p.normal_impulse, pushed);
     apply_normal(pair, p, p.normal_impulse + impulse);
 }
 
@@ -1688,7 +1702,9 @@ fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
     let t = perp(p.normal);
     let vt = pair.velocity_along(t, p.levers.tangent());
     let limit = p.friction * p.normal_impulse;
-    let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
+    let total = (-p.tangent_mass)
+        .mul_add(vt, p.tangent_impulse)
+        .clamp(-limit, limit);
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
     pair.apply_along(t, p.levers.tangent(), delta);
@@ -1749,18 +1765,22 @@ fn solve_normal_pair(
     // x₁ = −r₁ / k₁₁ (with normal_mass = 1 / k₁₁).
     let (k11, k12, k22) = (block.k11, block.k12, block.k22);
     let spring12 = k12.min(0.0);
-    let r1 =
-        mass_scale * (v1 - tp) - (k11 * x1 + k12 * x2) + impulse_scale * (k11 * x1 + spring12 * x2);
-    let r2 =
-        mass_scale * (v2 - tq) - (k12 * x1 + k22 * x2) + impulse_scale * (spring12 * x1 + k22 * x2);
+    // Each product added to another rounded once (`f64::mul_add`), as the lanes do.
+    let (kx1, kx2) = (k12.mul_add(x2, k11 * x1), k22.mul_add(x2, k12 * x1));
+    let (sx1, sx2) = (
+        spring12.mul_add(x2, k11 * x1),
+        k22.mul_add(x2, spring12 * x1),
+    );
+    let r1 = impulse_scale.mul_add(sx1, mass_scale.mul_add(v1 - tp, -kx1));
+    let r2 = impulse_scale.mul_add(sx2, mass_scale.mul_add(v2 - tq, -kx2));
     let (i11, i12, i22) = block.inverse;
-    let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
+    let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
     let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
     let totals = if both.0 >= 0.0 && both.1 >= 0.0 {
         both
-    } else if first >= 0.0 && k12 * first + r2 >= 0.0 {
+    } else if first >= 0.0 && k12.mul_add(first, r2) >= 0.0 {
         (first, 0.0)
-    } else if second >= 0.0 && k12 * second + r1 >= 0.0 {
+    } else if second >= 0.0 && k12.mul_add(second, r1) >= 0.0 {
         (0.0, second)
     } else {
         (0.0, 0.0) // r ≥ 0 is the only case left for a positive definite K

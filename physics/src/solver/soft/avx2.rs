@@ -1,6 +1,6 @@
 //! A batch's eight lanes in AVX2 registers, four to a register (`Avx2Lanes`), for the
-//! functions compiled with `#[target_feature(enable = "avx2")]` and nothing else. A row of
-//! eight lanes is two registers, its halves (lanes 0–3 and 4–7); a type computes the
+//! functions compiled with `#[target_feature(enable = "avx2,fma")]` and nothing else. A row
+//! of eight lanes is two registers, its halves (lanes 0–3 and 4–7); a type computes the
 //! halves `FIRST..END` of them and leaves the others alone:
 //!
 //! - `BothHalves` solves a full batch's passes: the two halves' manifolds share no moving
@@ -13,11 +13,11 @@
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
-//! { b }`, comparisons are ordered (false on NaN) except `!=`, and there is no fused
-//! multiply–add.
+//! { b }`, comparisons are ordered (false on NaN) except `!=`, and a fused multiply–add
+//! (`vfmadd`, `vfnmadd`) is `f64::mul_add`, rounded once.
 //!
-//! Only a function compiled for AVX2 may use these types, and only once the processor is
-//! known to have AVX2: their operations are `#[inline(always)]` wrappers of intrinsics
+//! Only a function compiled for AVX2 and FMA may use these types, and only once the
+//! processor is known to have both: their operations are `#[inline(always)]` wrappers of intrinsics
 //! that become single instructions when inlined there.
 
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
@@ -53,8 +53,8 @@ const _: () = {
 /// Lanes a half holds.
 const HALF: usize = LANES / 2;
 
-// SAFETY (every `unsafe` block below): the intrinsics need AVX2, which the functions these
-// types are used in are compiled for and only called with (`batch::LaneBatch`); the
+// SAFETY (every `unsafe` block below): the intrinsics need AVX2 and FMA, which the functions
+// these types are used in are compiled for and only called with (`batch::LaneBatch`); the
 // aligned loads and stores touch only the 32-byte rows `row` and `row_mut` name, which lie
 // inside their bodies at 0 or 32 bytes from the start of a 32-byte-aligned `SoftBody`, and
 // the bodies lie inside the slice (`Lanes::gather`'s precondition).
@@ -160,6 +160,20 @@ impl<const FIRST: usize, const END: usize> Lanes for Avx2Lanes<FIRST, END> {
     #[inline(always)]
     fn sqrt(self) -> Self {
         self.map(|a| unsafe { _mm256_sqrt_pd(a) })
+    }
+
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Self(on_halves::<FIRST, END>(self.0, |h| unsafe {
+            _mm256_fmadd_pd(self.0[h], a.0[h], b.0[h])
+        }))
+    }
+
+    #[inline(always)]
+    fn neg_mul_add(self, a: Self, b: Self) -> Self {
+        Self(on_halves::<FIRST, END>(self.0, |h| unsafe {
+            _mm256_fnmadd_pd(self.0[h], a.0[h], b.0[h])
+        }))
     }
 
     #[inline(always)]

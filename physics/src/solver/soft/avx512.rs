@@ -1,7 +1,7 @@
 //! The batches' eight lanes as one AVX-512 register (`Lanes` for `F64x8Avx512`), for the
 //! functions compiled with `#[target_feature(enable = "avx512f")]` and nothing else. Each
 //! operation is the one instruction whose result is the scalar code's to the bit, as in
-//! `avx2` (`maxpd`, `minpd`, ordered comparisons except `!=`, no fused multiply–add);
+//! `avx2` (`maxpd`, `minpd`, ordered comparisons except `!=`, `vfmadd` as `f64::mul_add`);
 //! the comparisons leave a mask register, one bit a lane.
 //!
 //! Only a function compiled for AVX-512 may use this type, and only once the processor
@@ -88,6 +88,16 @@ impl Lanes for F64x8Avx512 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         Self(unsafe { _mm512_sqrt_pd(self.0) })
+    }
+
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Self(unsafe { _mm512_fmadd_pd(self.0, a.0, b.0) })
+    }
+
+    #[inline(always)]
+    fn neg_mul_add(self, a: Self, b: Self) -> Self {
+        Self(unsafe { _mm512_fnmadd_pd(self.0, a.0, b.0) })
     }
 
     #[inline(always)]

@@ -1056,19 +1056,21 @@ impl<L: Lanes> LanePair<L> {
     #[inline(always)]
     fn velocity_along(&self, (dx, dy): (L, L), lever_a: L, lever_b: L) -> L {
         let (rx, ry) = (self.a.x - self.b.x, self.a.y - self.b.y);
-        rx * dx + ry * dy + self.a.w * lever_a - self.b.w * lever_b
+        let linear = ry.mul_add(dy, rx * dx);
+        let angular = self.b.w.neg_mul_add(lever_b, self.a.w * lever_a);
+        linear + angular
     }
 
     /// `BodyPair::apply_along`, lane by lane.
     #[inline(always)]
     fn apply_along(&mut self, (dx, dy): (L, L), lever_a: L, lever_b: L, impulse: L) {
         let (sa, sb) = (impulse * self.a.inv_mass, impulse * self.b.inv_mass);
-        self.a.x += dx * sa;
-        self.a.y += dy * sa;
-        self.a.w += self.inv_inertia.0 * lever_a * impulse;
-        self.b.x -= dx * sb;
-        self.b.y -= dy * sb;
-        self.b.w -= self.inv_inertia.1 * lever_b * impulse;
+        self.a.x = dx.mul_add(sa, self.a.x);
+        self.a.y = dy.mul_add(sa, self.a.y);
+        self.a.w = (self.inv_inertia.0 * lever_a).mul_add(impulse, self.a.w);
+        self.b.x = dx.neg_mul_add(sb, self.b.x);
+        self.b.y = dy.neg_mul_add(sb, self.b.y);
+        self.b.w = (self.inv_inertia.1 * lever_b).neg_mul_add(impulse, self.b.w);
     }
 }
 
@@ -1121,11 +1123,19 @@ impl LanePath {
             if std::arch::is_x86_feature_detected!("avx512f") {
                 return Self::Avx512;
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if Self::has_avx2_and_fma() {
                 return Self::Avx2;
             }
         }
         Self::Portable
+    }
+
+    /// The AVX2 path's fused multiply–adds (`Lanes::mul_add`) are FMA's instructions: every
+    /// processor with AVX2 but a few has it.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn has_avx2_and_fma() -> bool {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
     }
 
     /// Every path this processor runs, the portable one first.
@@ -1134,7 +1144,7 @@ impl LanePath {
         let mut paths = vec![Self::Portable];
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if Self::has_avx2_and_fma() {
                 paths.push(Self::Avx2);
             }
             if std::arch::is_x86_feature_detected!("avx512f") {
@@ -1219,9 +1229,9 @@ unsafe fn as_lanes_mut<B: LaneBatch, L: Lanes>(batch: &mut B) -> &mut B::With<L>
 /// start goes half by half (a batch's lanes share no moving body, so each half is as if
 /// alone), skipping an unused upper half; see `avx2`.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn warm_start_avx2<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
-    // SAFETY (both): this function runs only where the processor has AVX2
+    // SAFETY (both): this function runs only where the processor has AVX2 and FMA
     // (`LaneBatch::warm_start_on`).
     unsafe { as_lanes::<B, LowerHalf>(batch) }.warm_start_lanes(bodies);
     if batch.upper_half_used() {
@@ -1231,9 +1241,9 @@ fn warm_start_avx2<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
 
 /// A pass solves both halves at once, interleaved, unless the upper one is unused.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn solve_avx2<B: LaneBatch>(batch: &mut B, bodies: &mut [SoftBody], pass: &B::Pass) {
-    // SAFETY (both): this function runs only where the processor has AVX2
+    // SAFETY (both): this function runs only where the processor has AVX2 and FMA
     // (`LaneBatch::solve_on`).
     if batch.upper_half_used() {
         unsafe { as_lanes_mut::<B, BothHalves>(batch) }.solve_lanes(bodies, pass);
@@ -1468,12 +1478,12 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let [dpx_b, dpy_b, cos_b, sin_b] = unsafe { L::gather(bodies, &self.b, BodyRow::Motion) };
         let (dx, dy) = (dpx_a - dpx_b, dpy_a - dpy_b);
         let one = L::splat(1.0);
-        let moved = dx * self.normal_x + dy * self.normal_y;
+        let moved = dy.mul_add(self.normal_y, dx * self.normal_x);
         // Written out in the loop: a closure here was left out of line.
         let mut separations = [L::splat(0.0); N];
         for (s, p) in separations.iter_mut().zip(&self.points) {
-            let turned_a = (cos_a - one) * p.reach_a + sin_a * p.normal_lever_a;
-            let turned_b = (cos_b - one) * p.reach_b + sin_b * p.normal_lever_b;
+            let turned_a = sin_a.mul_add(p.normal_lever_a, (cos_a - one) * p.reach_a);
+            let turned_b = sin_b.mul_add(p.normal_lever_b, (cos_b - one) * p.reach_b);
             *s = moved + turned_a - turned_b + p.base_separation;
         }
         separations
@@ -1554,26 +1564,28 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let points = &self.points[..];
         let [x1, x2] = [self.normal_impulses[0], self.normal_impulses[1]];
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
+        let (kx1, kx2) = (k12.mul_add(x2, k11 * x1), k22.mul_add(x2, k12 * x1));
         let (r1, r2) = if BIAS {
             let spring12 = k12.min(zero);
+            let (sx1, sx2) = (
+                spring12.mul_add(x2, k11 * x1),
+                k22.mul_add(x2, spring12 * x1),
+            );
             (
-                ms1 * (v1 - t1) - (k11 * x1 + k12 * x2) + s1 * (k11 * x1 + spring12 * x2),
-                ms2 * (v2 - t2) - (k12 * x1 + k22 * x2) + s2 * (spring12 * x1 + k22 * x2),
+                s1.mul_add(sx1, ms1.mul_add(v1 - t1, -kx1)),
+                s2.mul_add(sx2, ms2.mul_add(v2 - t2, -kx2)),
             )
         } else {
             // Mass scale 1 and impulse scale 0 (`solve_lanes`).
-            (
-                (v1 - t1) - (k11 * x1 + k12 * x2),
-                (v2 - t2) - (k12 * x1 + k22 * x2),
-            )
+            ((v1 - t1) - kx1, (v2 - t2) - kx2)
         };
         let [i11, i12, i22] = self.inverse;
-        let both = (-(i11 * r1 + i12 * r2), -(i12 * r1 + i22 * r2));
+        let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
         let first = -r1 * points[0].normal_mass;
         let second = -r2 * points[1].normal_mass;
         let take_both = both.0.ge(zero) & both.1.ge(zero);
-        let take_first = first.ge(zero) & (k12 * first + r2).ge(zero);
-        let take_second = second.ge(zero) & (k12 * second + r1).ge(zero);
+        let take_first = first.ge(zero) & k12.mul_add(first, r2).ge(zero);
+        let take_second = second.ge(zero) & k12.mul_add(second, r1).ge(zero);
         let total1 = take_both.select(both.0, take_first.select(first, zero));
         let total2 = take_both.select(
             both.1,
@@ -1679,7 +1691,10 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         for (p, &normal_impulse) in self.points.iter_mut().zip(&self.normal_impulses) {
             let vt = pair.velocity_along(tangent, p.reach_a, p.reach_b);
             let limit = self.friction * normal_impulse;
-            let total = (p.tangent_impulse - p.tangent_mass * vt).clamp(-limit, limit);
+            let total = p
+                .tangent_mass
+                .neg_mul_add(vt, p.tangent_impulse)
+                .clamp(-limit, limit);
             let delta = total - p.tangent_impulse;
             p.tangent_impulse.set(total);
             pair.apply_along(tangent, p.reach_a, p.reach_b, delta);
@@ -1749,7 +1764,7 @@ fn solve_normals_alone<L: Lanes, const BIAS: bool>(
         }
         let accumulated = *impulse;
         let change = if BIAS {
-            -p.normal_mass * mass_scale * (vn - target) - impulse_scale * accumulated
+            impulse_scale.neg_mul_add(accumulated, -p.normal_mass * mass_scale * (vn - target))
         } else {
             -p.normal_mass * (vn - target)
         };

@@ -3,7 +3,8 @@
 //! register, both halves of a row or one, inside the functions compiled for AVX2; and
 //! `avx512::F64x8Avx512`, all of them in one 512-bit register, inside those compiled for
 //! AVX-512 (chosen at run time, see `batch::LanePath::best`). Every lane rounds as the
-//! scalar code does, so all three give the same bits.
+//! scalar code does, so all three give the same bits: where the scalar code fuses a
+//! multiply and an add (`f64::mul_add`, one rounding), the lanes do too (`Lanes::mul_add`).
 
 use super::{BodyRow, SoftBody};
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
@@ -33,6 +34,11 @@ pub(super) trait Lanes:
     /// `lo <= hi`: the upper bound where `hi < x`, then the lower where `lo >` that.
     fn clamp(self, lo: Self, hi: Self) -> Self;
     fn sqrt(self) -> Self;
+    /// `self · a + b` rounded once: `f64::mul_add` lane by lane.
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// `b − self · a` rounded once: `(−self).mul_add(a, b)` lane by lane (negating is
+    /// exact).
+    fn neg_mul_add(self, a: Self, b: Self) -> Self;
     fn gt(self, rhs: Self) -> Self::Mask;
     fn ge(self, rhs: Self) -> Self::Mask;
     fn lt(self, rhs: Self) -> Self::Mask;
@@ -123,6 +129,16 @@ impl Lanes for F64x8 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         Self::from_fn(|k| self.0[k].sqrt())
+    }
+
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        Self::from_fn(|k| self.0[k].mul_add(a.0[k], b.0[k]))
+    }
+
+    #[inline(always)]
+    fn neg_mul_add(self, a: Self, b: Self) -> Self {
+        Self::from_fn(|k| (-self.0[k]).mul_add(a.0[k], b.0[k]))
     }
 
     #[inline(always)]
