@@ -254,7 +254,7 @@ impl NormalBlock {
         let k11 = row_coupling(m, inertias, l1, l1);
         let k12 = row_coupling(m, inertias, l1, l2);
         let k22 = row_coupling(m, inertias, l2, l2);
-        let det = k11 * k22 - k12 * k12;
+        let det = k11.mul_add(k22, -(k12 * k12));
         (k11 > 0.0 && k22 > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det).then(|| {
             let inv_det = 1.0 / det;
             Self {
@@ -280,11 +280,13 @@ impl PointLevers {
     #[inline(always)]
     fn of(bodies: &[SolverBody], c: &Contact) -> Self {
         let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-        let r_a = c.point - a.position;
-        let r_b = c.point - b.position;
+        let n = c.normal;
+        let (r_a, r_b) = (c.point - a.position, c.point - b.position);
+        let cross = |r: Vec2| r.x.mul_add(n.y, -(r.y * n.x));
+        let dot = |r: Vec2| r.y.mul_add(n.y, r.x * n.x);
         Self {
-            normal: (cross(r_a, c.normal), cross(r_b, c.normal)),
-            reach: (r_a.dot(&c.normal), r_b.dot(&c.normal)),
+            normal: (cross(r_a), cross(r_b)),
+            reach: (dot(r_a), dot(r_b)),
         }
     }
 
@@ -304,7 +306,7 @@ fn row_coupling(
     (a1, b1): (f64, f64),
     (a2, b2): (f64, f64),
 ) -> f64 {
-    inv_masses + ia * a1 * a2 + ib * b1 * b2
+    (ib * b1).mul_add(b2, (ia * a1).mul_add(a2, inv_masses))
 }
 
 /// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
