@@ -124,27 +124,33 @@ impl ManifoldCache {
         }
     }
 
-    /// The pair's last manifold at the current poses, if the pair has moved relative to
-    /// itself by less than `tolerance` (at any point of either body) since it was found,
-    /// `margin` is no wider than it was then, and a point is still within `margin`.
-    /// `None` asks for a fresh test, whose result goes to `store`.
-    pub fn reuse(
+    /// Pushes onto `manifolds` the pair's last manifold at the current poses, if the pair
+    /// has moved relative to itself by less than `tolerance` (at any point of either body)
+    /// since it was found, `margin` is no wider than it was then, and a point is still
+    /// within `margin`. `false` asks for a fresh test, whose result goes to `store`.
+    ///
+    /// The manifold is made where it lies in the list. Made on the stack point by point
+    /// and then moved there whole, its copy's wide loads waited on the narrower stores
+    /// just made (the store cannot be forwarded): half of this function's time on a pile.
+    pub fn reuse_into(
         &mut self,
         (a, pose_a): (BodyHandle, &Pose),
         (b, pose_b): (BodyHandle, &Pose),
-        margin: f64,
-        tolerance: f64,
-    ) -> Option<Manifold> {
+        (margin, tolerance): (f64, f64),
+        manifolds: &mut Vec<Manifold>,
+    ) -> bool {
         let pair = (a.0, b.0);
         while self.last.get(self.cursor).is_some_and(|c| c.pair < pair) {
             self.cursor += 1;
         }
-        let cached = self.last.get(self.cursor).filter(|c| c.pair == pair)?;
+        let Some(cached) = self.last.get(self.cursor).filter(|c| c.pair == pair) else {
+            return false;
+        };
         let (offset, turn) = relative_pose(pose_a, pose_b);
         let moved = (offset - cached.relative.0).norm()
             + (turn - cached.relative.1).abs() * pose_a.radius.max(pose_b.radius);
         if moved > tolerance || margin > cached.margin {
-            return None;
+            return false;
         }
         let (reference, incident) = if cached.reference_is_b {
             (pose_b, pose_a)
@@ -152,7 +158,12 @@ impl ManifoldCache {
             (pose_a, pose_b)
         };
         let u = reference.rotation.apply(cached.normal);
-        let mut manifold = Manifold::new(a, b, if cached.reference_is_b { u } else { -u });
+        manifolds.push(Manifold::new(
+            a,
+            b,
+            if cached.reference_is_b { u } else { -u },
+        ));
+        let manifold = manifolds.last_mut().expect("just pushed");
         manifold.reference_is_b = cached.reference_is_b;
         for p in &cached.points[..cached.len as usize] {
             let point = incident.to_world(p.incident);
@@ -166,10 +177,11 @@ impl ManifoldCache {
             }
         }
         if manifold.points().is_empty() {
-            return None;
+            manifolds.pop();
+            return false;
         }
         self.keep();
-        Some(manifold)
+        true
     }
 
     /// Keeps a freshly found manifold for the next steps.
@@ -231,6 +243,21 @@ impl ManifoldCache {
 mod tests {
     use super::*;
     use crate::collide::{WorldPolygon, collide_polygons};
+
+    impl ManifoldCache {
+        /// `reuse_into` a list of its own: the manifold reused, if any.
+        fn reuse(
+            &mut self,
+            a: (BodyHandle, &Pose),
+            b: (BodyHandle, &Pose),
+            margin: f64,
+            tolerance: f64,
+        ) -> Option<Manifold> {
+            let mut manifolds = Vec::new();
+            self.reuse_into(a, b, (margin, tolerance), &mut manifolds)
+                .then(|| manifolds[0])
+        }
+    }
 
     fn unit_square() -> Vec<Vec2> {
         vec![
