@@ -148,9 +148,11 @@ impl ManifoldCache {
             return false;
         };
         let (offset, turn) = relative_pose(pose_a, pose_b);
-        let moved = (offset - cached.relative.0).norm()
-            + (turn - cached.relative.1).abs() * pose_a.radius.max(pose_b.radius);
-        if moved > tolerance || margin > cached.margin {
+        // The shift within what the turn leaves of the tolerance, compared squared: the
+        // square root's latency held up every pair.
+        let left = tolerance - (turn - cached.relative.1).abs() * pose_a.radius.max(pose_b.radius);
+        let shift = offset - cached.relative.0;
+        if left < 0.0 || shift.norm_squared() > left * left || margin > cached.margin {
             return false;
         }
         let (reference, incident) = if cached.reference_is_b {
