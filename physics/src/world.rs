@@ -3,7 +3,7 @@
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
-use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon, collide_polygons};
+use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon, collide_polygons_into};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, mixed_friction, restitution_threshold, solve_sequential};
 use crate::solver::island::UnionFind;
@@ -1593,29 +1593,24 @@ impl World {
             {
                 continue;
             }
-            let found = {
-                s.polygons[i as usize].ensure_normals();
-                s.polygons[j as usize].ensure_normals();
-                let found = collide_polygons(
-                    (a, &s.polygons[i as usize]),
-                    (b, &s.polygons[j as usize]),
-                    pair_margin,
-                    tie,
-                );
-                // A pair that may move past the reuse tolerance in this step will not be
-                // reused at the next one: the smash's debris found ~50,000 manifolds a step
-                // and reused ~1,300.
-                let (motion_a, motion_b) = (s.motion[i as usize], s.motion[j as usize]);
-                if let Some(m) = &found
-                    && self.settings.reuse_manifolds
-                    && !relative_reach_exceeds(motion_a, motion_b, reuse_tolerance)
-                {
-                    cache.store(m, (pose_a, pose_b), pair_margin);
-                }
-                found
-            };
-            if let Some(m) = found {
-                self.manifolds.push(m);
+            s.polygons[i as usize].ensure_normals();
+            s.polygons[j as usize].ensure_normals();
+            let found = collide_polygons_into(
+                (a, &s.polygons[i as usize]),
+                (b, &s.polygons[j as usize]),
+                (pair_margin, tie),
+                &mut self.manifolds,
+            );
+            // A pair that may move past the reuse tolerance in this step will not be reused
+            // at the next one: the smash's debris found ~50,000 manifolds a step and reused
+            // ~1,300.
+            let (motion_a, motion_b) = (s.motion[i as usize], s.motion[j as usize]);
+            if found
+                && self.settings.reuse_manifolds
+                && !relative_reach_exceeds(motion_a, motion_b, reuse_tolerance)
+                && let Some(m) = self.manifolds.last()
+            {
+                cache.store(m, (pose_a, pose_b), pair_margin);
             }
         }
         stage_clock::record(Stage::NarrowPhase, started);

@@ -8,7 +8,7 @@ pub mod toi;
 
 pub use broad::BroadPhase;
 pub use pair_set::PairSet;
-pub use sat::collide_polygons;
+pub use sat::{collide_polygons, collide_polygons_into};
 
 use crate::body::{Body, BodyHandle};
 use crate::math::Vec2;
