@@ -1130,8 +1130,8 @@ impl LanePath {
         Self::Portable
     }
 
-    /// The AVX2 path's fused multiply–adds (`Lanes::mul_add`) are FMA's instructions: every
-    /// processor with AVX2 but a few has it.
+    /// The AVX2 path's fused multiply–adds (`Lanes::mul_add`) are FMA's instructions, which
+    /// every AVX2 processor from Intel and AMD has.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn has_avx2_and_fma() -> bool {
