@@ -3,13 +3,13 @@
 //! of eight lanes is two registers, its halves (lanes 0–3 and 4–7); a type computes the
 //! halves `FIRST..END` of them and leaves the others alone:
 //!
-//! - `BothHalves` solves a full batch's passes: the two halves' manifolds share no moving
-//!   body, so their chains of dependent updates are independent, and interleaved they
-//!   keep the processor busy where one half alone waits on each result (docs/bench/
-//!   profile.md, "Both halves at once").
-//! - `LowerHalf` and `UpperHalf` solve a batch half by half: the warm start, whose short
-//!   chain gains nothing from interleaving and pays for the registers it spills, and a
-//!   batch whose upper half is unused, which is then skipped.
+//! - `BothHalves` warm-starts and solves a full batch: the two halves' manifolds share no
+//!   moving body, so their chains of dependent updates are independent, and interleaved
+//!   they keep the processor busy where one half alone waits on each result (docs/bench/
+//!   profile.md, "Both halves at once"; the warm start too since its multiply–adds are
+//!   fused, "Fused multiply–adds in the contact rows").
+//! - `LowerHalf` computes lanes 0–3 of a batch whose upper half is unused, which is then
+//!   skipped.
 //!
 //! Each operation is the one instruction whose result is the scalar code's to the bit:
 //! `maxpd(a, b)` is `if a > b { a } else { b }`, `minpd(a, b)` is `if a < b { a } else
@@ -17,8 +17,8 @@
 //! (`vfmadd`, `vfnmadd`) is `f64::mul_add`, rounded once.
 //!
 //! Only a function compiled for AVX2 and FMA may use these types, and only once the
-//! processor is known to have both: their operations are `#[inline(always)]` wrappers of intrinsics
-//! that become single instructions when inlined there.
+//! processor is known to have both: their operations are `#[inline(always)]` wrappers of
+//! intrinsics that become single instructions when inlined there.
 
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, SoftBody};
@@ -37,8 +37,6 @@ pub(super) struct Avx2Lanes<const FIRST: usize, const END: usize>([__m256d; 2]);
 pub(super) type BothHalves = Avx2Lanes<0, 2>;
 /// Lanes 0–3.
 pub(super) type LowerHalf = Avx2Lanes<0, 1>;
-/// Lanes 4–7.
-pub(super) type UpperHalf = Avx2Lanes<1, 2>;
 
 /// A lane-wise condition of the same halves: all ones or all zeros per lane.
 #[derive(Debug, Clone, Copy)]

@@ -18,7 +18,7 @@
 //! 0.25% of a box over 500 steps (Box2D v3 0.94%): see docs/bench/profile.md.
 
 #[cfg(target_arch = "x86_64")]
-use super::avx2::{BothHalves, LowerHalf, UpperHalf};
+use super::avx2::{BothHalves, LowerHalf};
 #[cfg(target_arch = "x86_64")]
 use super::avx512::F64x8Avx512;
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
@@ -961,10 +961,10 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
 #[cfg(target_arch = "x86_64")]
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, UpperHalf>>());
-    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, UpperHalf>>());
-    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, UpperHalf>>());
-    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, UpperHalf>>());
+    assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, BothHalves>>());
+    assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, BothHalves>>());
+    assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, BothHalves>>());
+    assert!(align_of::<ManifoldBatch<1>>() == align_of::<ManifoldBatch<1, BothHalves>>());
     assert!(size_of::<ManifoldBatch<2>>() == size_of::<ManifoldBatch<2, F64x8Avx512>>());
     assert!(size_of::<ManifoldBatch<1>>() == size_of::<ManifoldBatch<1, F64x8Avx512>>());
     assert!(align_of::<ManifoldBatch<2>>() == align_of::<ManifoldBatch<2, F64x8Avx512>>());
@@ -1225,17 +1225,17 @@ unsafe fn as_lanes_mut<B: LaneBatch, L: Lanes>(batch: &mut B) -> &mut B::With<L>
     unsafe { &mut *(batch as *mut B).cast::<B::With<L>>() }
 }
 
-/// The same code compiled for AVX2, whose 256-bit registers hold half the lanes. The warm
-/// start goes half by half (a batch's lanes share no moving body, so each half is as if
-/// alone), skipping an unused upper half; see `avx2`.
+/// The same code compiled for AVX2, whose 256-bit registers hold half the lanes: both
+/// halves at once, interleaved, unless the upper one is unused; see `avx2`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn warm_start_avx2<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
     // SAFETY (both): this function runs only where the processor has AVX2 and FMA
     // (`LaneBatch::warm_start_on`).
-    unsafe { as_lanes::<B, LowerHalf>(batch) }.warm_start_lanes(bodies);
     if batch.upper_half_used() {
-        unsafe { as_lanes::<B, UpperHalf>(batch) }.warm_start_lanes(bodies);
+        unsafe { as_lanes::<B, BothHalves>(batch) }.warm_start_lanes(bodies);
+    } else {
+        unsafe { as_lanes::<B, LowerHalf>(batch) }.warm_start_lanes(bodies);
     }
 }
 

@@ -13,7 +13,7 @@ use super::batch::{BatchLanes, LaneBatch, LanePath, LaneVelocity, PAD};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
 use super::{BodyRow, DIRECT_JOINT_LIMIT, SoftBody, SoftJoint, Softness};
 #[cfg(target_arch = "x86_64")]
-use super::{avx2::UpperHalf, avx512::F64x8Avx512};
+use super::{avx2::BothHalves, avx512::F64x8Avx512};
 use crate::math::Vec2;
 use crate::solver::island::counting_sort;
 
@@ -196,8 +196,8 @@ pub(super) struct PinBatch<L = F64x8> {
 #[cfg(target_arch = "x86_64")]
 const _: () = {
     use std::mem::{align_of, size_of};
-    assert!(size_of::<PinBatch>() == size_of::<PinBatch<UpperHalf>>());
-    assert!(align_of::<PinBatch>() == align_of::<PinBatch<UpperHalf>>());
+    assert!(size_of::<PinBatch>() == size_of::<PinBatch<BothHalves>>());
+    assert!(align_of::<PinBatch>() == align_of::<PinBatch<BothHalves>>());
     assert!(size_of::<PinBatch>() == size_of::<PinBatch<F64x8Avx512>>());
     assert!(align_of::<PinBatch>() == align_of::<PinBatch<F64x8Avx512>>());
 };
