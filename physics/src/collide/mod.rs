@@ -130,18 +130,9 @@ pub struct Manifold {
 }
 
 impl Manifold {
-    pub fn new(body_a: BodyHandle, body_b: BodyHandle, normal: Vec2) -> Self {
-        Self {
-            body_a,
-            body_b,
-            normal,
-            points: [ContactPoint::default(); 2],
-            len: 0,
-            reference_is_b: false,
-        }
-    }
-
-    /// A manifold of the first `len` of `points`, found against `reference_is_b`'s edge.
+    /// A manifold of the first `len` of `points`, found against `reference_is_b`'s edge:
+    /// made whole from its points, never filled in afterwards (see
+    /// `ManifoldCache::reuse_into`).
     pub(crate) fn with_points(
         (body_a, body_b): (BodyHandle, BodyHandle),
         normal: Vec2,
@@ -158,19 +149,8 @@ impl Manifold {
         }
     }
 
-    pub fn push(&mut self, point: ContactPoint) {
-        if (self.len as usize) < self.points.len() {
-            self.points[self.len as usize] = point;
-            self.len += 1;
-        }
-    }
-
     pub fn points(&self) -> &[ContactPoint] {
         &self.points[..self.len as usize]
-    }
-
-    pub fn points_mut(&mut self) -> &mut [ContactPoint] {
-        &mut self.points[..self.len as usize]
     }
 
     /// The deepest penetration of the manifold.

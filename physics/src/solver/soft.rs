@@ -282,11 +282,12 @@ impl PointLevers {
         let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
         let n = c.normal;
         let (r_a, r_b) = (c.point - a.position, c.point - b.position);
-        let cross = |r: Vec2| r.x.mul_add(n.y, -(r.y * n.x));
-        let dot = |r: Vec2| r.y.mul_add(n.y, r.x * n.x);
+        // r × n and r · n, each product added with one rounding (see `BodyPair`).
+        let lever = |r: Vec2| r.x.mul_add(n.y, -(r.y * n.x));
+        let reach = |r: Vec2| r.y.mul_add(n.y, r.x * n.x);
         Self {
-            normal: (cross(r_a), cross(r_b)),
-            reach: (dot(r_a), dot(r_b)),
+            normal: (lever(r_a), lever(r_b)),
+            reach: (reach(r_a), reach(r_b)),
         }
     }
 
