@@ -4,7 +4,7 @@
 //! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
 //! outcome; with `throws [count] [seed] [list]`, the random throws alone (`throws.rs`),
 //! listing each that sinks with `list`; with `stages <scene>` (feature `stages`), pe's
-//! stages beside Box2D v3's own profile of the same scene.
+//! stages beside rapier2d's and Box2D v3's own profiles of the same scene.
 //!
 //! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws]` inside bench/.
 
@@ -138,7 +138,7 @@ fn main() {
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("stages") {
-        run_stages_beside_box2d();
+        run_stages_beside_peers();
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("pile") {
@@ -303,13 +303,14 @@ fn print_stage_cycles(from: Option<usize>) {
 }
 
 /// `stages <scene> [steps=N] [from=K]`, in a build with the feature `stages`: pe
-/// `soft`'s stage clock and Box2D v3's own profile (`b2World_GetProfile`) on one of
-/// `pile_scenes`, one engine's N steps (300 by default) after the other's, each stage's
-/// median microseconds over the steps from the K-th (half way by default), the stages
-/// matched as closely as the two steps allow (a row with no pe stage reads 0). Box2D
-/// times its stages with the wall clock, pe with its stage clock, converted at the rate
+/// `soft`'s stage clock beside rapier2d's own timers (its `Counters`) and Box2D v3's own
+/// profile (`b2World_GetProfile`) on one of `pile_scenes`, each engine's N steps (300 by
+/// default) after the other's, each stage's median microseconds over the steps from the
+/// K-th (half way by default), the stages matched as closely as the steps allow (a row
+/// with no stage of an engine reads 0: that engine times it within another row). The peers
+/// time their stages with the wall clock, pe with its stage clock, converted at the rate
 /// `stage_clock::ticks_per_microsecond` measures.
-fn run_stages_beside_box2d() {
+fn run_stages_beside_peers() {
     use pe::stage_clock::{self, Stage};
     let args: Vec<String> = std::env::args().skip(2).collect();
     let scene = args.first().cloned().unwrap_or_default();
@@ -330,9 +331,13 @@ fn run_stages_beside_box2d() {
     harness::fixed_steps(steps);
     // `pile_jobs`: pe `soft`, rapier2d, Box2D v3.
     let box2d_job = jobs.pop().expect("Box2D v3's job");
+    let rapier_job = jobs.pop().expect("rapier2d's job");
     let pe_run = jobs.swap_remove(0)();
     let pe_steps = stage_clock::take_steps();
     let ticks_per_microsecond = stage_clock::ticks_per_microsecond().expect("enabled");
+    rapier_scenes::keep_profiles();
+    rapier_job();
+    let rapier = rapier_scenes::take_profiles();
     box2d_scenes::keep_profiles();
     box2d_job();
     let box2d = box2d_scenes::take_profiles();
@@ -351,9 +356,10 @@ fn run_stages_beside_box2d() {
                 .collect(),
         )
     };
-    // (what, pe's stages, Box2D v3's fields and their names)
-    type Fields = fn(&boxdd::Profile) -> f32;
-    let box2d_time = |fields: Fields| {
+    type RapierFields = fn(&rapier_scenes::Profile) -> f64;
+    let rapier_time = |fields: RapierFields| median(rapier[from..].iter().map(fields).collect());
+    type Box2dFields = fn(&boxdd::Profile) -> f32;
+    let box2d_time = |fields: Box2dFields| {
         median(
             box2d[from..]
                 .iter()
@@ -361,81 +367,117 @@ fn run_stages_beside_box2d() {
                 .collect(),
         )
     };
-    let rows: [(&str, &[Stage], Fields, &str); 8] = [
-        (
-            "broad phase",
-            &[Stage::BroadPhase],
-            |p| p.pairs + p.refit,
-            "pairs + refit",
-        ),
-        (
-            "narrow phase and contacts",
-            &[Stage::NarrowPhase, Stage::Contacts],
-            |p| p.collide,
-            "collide",
-        ),
-        (
-            "preparing",
-            &[Stage::Preparing],
-            |p| p.prepare_stages + p.prepare_constraints,
-            "prepareStages + prepareConstraints",
-        ),
-        (
-            "velocities integrated",
-            &[],
-            |p| p.integrate_velocities,
-            "integrateVelocities (pe: in the rest)",
-        ),
-        (
-            "warm start",
-            &[Stage::WarmStart],
-            |p| p.warm_start,
-            "warmStart",
-        ),
-        (
-            "solve",
-            &[Stage::Solve],
-            |p| p.solve_impulses + p.integrate_positions + p.relax_impulses,
-            "solveImpulses + integratePositions + relaxImpulses",
-        ),
-        (
-            "storing",
-            &[Stage::Storing],
-            |p| p.store_impulses + p.transforms,
-            "storeImpulses + transforms",
-        ),
-        (
-            "continuous collision",
-            &[Stage::Continuous],
-            |p| p.bullets,
-            "bullets (other fast bodies: in transforms)",
-        ),
+    struct Row {
+        name: &'static str,
+        pe: &'static [Stage],
+        rapier: RapierFields,
+        rapier_names: &'static str,
+        box2d: Box2dFields,
+        box2d_names: &'static str,
+    }
+    let rows = [
+        Row {
+            name: "broad phase",
+            pe: &[Stage::BroadPhase],
+            rapier: |p| p.broad_phase,
+            rapier_names: "broad phase (both)",
+            box2d: |p| p.pairs + p.refit,
+            box2d_names: "pairs + refit",
+        },
+        Row {
+            name: "narrow phase and contacts",
+            pe: &[Stage::NarrowPhase, Stage::Contacts],
+            rapier: |p| p.narrow_phase,
+            rapier_names: "narrow phase",
+            box2d: |p| p.collide,
+            box2d_names: "collide",
+        },
+        Row {
+            name: "preparing",
+            pe: &[Stage::Preparing],
+            rapier: |p| p.islands + p.assembly,
+            rapier_names: "islands + velocity assembly",
+            box2d: |p| p.prepare_stages + p.prepare_constraints,
+            box2d_names: "prepareStages + prepareConstraints",
+        },
+        Row {
+            name: "velocities integrated",
+            pe: &[],
+            rapier: |p| p.update,
+            rapier_names: "update (bodies and forces)",
+            box2d: |p| p.integrate_velocities,
+            box2d_names: "integrateVelocities (pe: in the rest)",
+        },
+        Row {
+            name: "warm start",
+            pe: &[Stage::WarmStart],
+            rapier: |_| 0.0,
+            rapier_names: "(in velocity resolution)",
+            box2d: |p| p.warm_start,
+            box2d_names: "warmStart",
+        },
+        Row {
+            name: "solve",
+            pe: &[Stage::Solve],
+            rapier: |p| p.resolution,
+            rapier_names: "velocity resolution (passes, integration, writeback)",
+            box2d: |p| p.solve_impulses + p.integrate_positions + p.relax_impulses,
+            box2d_names: "solveImpulses + integratePositions + relaxImpulses",
+        },
+        Row {
+            name: "storing",
+            pe: &[Stage::Storing],
+            rapier: |_| 0.0,
+            rapier_names: "(in velocity resolution)",
+            box2d: |p| p.store_impulses + p.transforms,
+            box2d_names: "storeImpulses + transforms",
+        },
+        Row {
+            name: "continuous collision",
+            pe: &[Stage::Continuous],
+            rapier: |p| p.ccd,
+            rapier_names: "ccd",
+            box2d: |p| p.bullets,
+            box2d_names: "bullets (other fast bodies: in transforms)",
+        },
     ];
-    let whole = (pe_time(&[Stage::Step]), box2d_time(|p| p.step));
+    let whole = (
+        pe_time(&[Stage::Step]),
+        rapier_time(|p| p.step),
+        box2d_time(|p| p.step),
+    );
     println!(
         "{scene} under pe soft: {pe_run:?}\n\n{scene} over {} steps from step {from}, \
          median microseconds a step (the stage clock at {ticks_per_microsecond:.0} ticks \
          a microsecond)\n",
         steps - from,
     );
-    println!("| stage | pe soft | Box2D v3 | pe − Box2D v3 | Box2D v3's fields |");
-    println!("| --- | ---: | ---: | ---: | --- |");
-    let print_row = |name: &str, (pe, b2): (f64, f64), field_names: &str| {
+    println!("| stage | pe soft | rapier2d | Box2D v3 | rapier2d's timers | Box2D v3's fields |");
+    println!("| --- | ---: | ---: | ---: | --- | --- |");
+    let print_row = |name: &str, (pe, rapier, b2): (f64, f64, f64), names: (&str, &str)| {
         println!(
-            "| {name} | {pe:.0} | {b2:.0} | {:+.0} | {field_names} |",
-            pe - b2
+            "| {name} | {pe:.0} | {rapier:.0} | {b2:.0} | {} | {} |",
+            names.0, names.1
         );
     };
-    let mut parts = (0.0, 0.0);
-    for (name, stages, fields, field_names) in rows {
-        let (pe, b2) = (pe_time(stages), box2d_time(fields));
-        parts = (parts.0 + pe, parts.1 + b2);
-        print_row(name, (pe, b2), field_names);
+    let mut parts = (0.0, 0.0, 0.0);
+    for row in rows {
+        let times = (
+            pe_time(row.pe),
+            rapier_time(row.rapier),
+            box2d_time(row.box2d),
+        );
+        parts = (parts.0 + times.0, parts.1 + times.1, parts.2 + times.2);
+        print_row(row.name, times, (row.rapier_names, row.box2d_names));
     }
-    let rest = (whole.0 - parts.0, whole.1 - parts.1);
-    let rest_name = "the rest (whole step less the medians above)";
-    print_row(rest_name, rest, "step less the above");
-    print_row("whole step", whole, "step");
+    let rest = (whole.0 - parts.0, whole.1 - parts.1, whole.2 - parts.2);
+    let rest_names = ("step less the above", "step less the above");
+    print_row(
+        "the rest (whole step less the medians above)",
+        rest,
+        rest_names,
+    );
+    print_row("whole step", whole, ("step", "step"));
 }
 
 /// The scenes of `pile`: every pile, the joint grid and the smash.

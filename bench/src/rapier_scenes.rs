@@ -10,6 +10,8 @@ use crate::scene::{
     momentum_and_kinetic_energy, smash, worst,
 };
 use rapier2d::prelude::*;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A scene point as rapier's vector type.
 fn point((x, y): (f64, f64)) -> Vector {
@@ -19,6 +21,59 @@ fn point((x, y): (f64, f64)) -> Vector {
 fn centre(world: &PhysicsWorld, body: RigidBodyHandle) -> (f64, f64) {
     let t = world.bodies[body].translation();
     (f64::from(t.x), f64::from(t.y))
+}
+
+/// rapier2d's own timing of one step's stages (its `Counters`), in microseconds, for
+/// `stages` to set beside pe's stage clock. Zero unless the bench is built with the
+/// feature `stages` (rapier2d's `profiler`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Profile {
+    pub step: f64,
+    pub broad_phase: f64,
+    pub narrow_phase: f64,
+    pub islands: f64,
+    /// Bodies and forces updated before the solve (`update_time`).
+    pub update: f64,
+    /// The contact and joint constraints built (`velocity_assembly_time`).
+    pub assembly: f64,
+    /// The solver's passes with their integration and the impulses written back
+    /// (`velocity_resolution_time`).
+    pub resolution: f64,
+    pub ccd: f64,
+}
+
+/// Whether `step` keeps each step's `Profile`.
+static KEEP_PROFILES: AtomicBool = AtomicBool::new(false);
+static PROFILES: Mutex<Vec<Profile>> = Mutex::new(Vec::new());
+
+/// From now on, every step's profile is kept, until `take_profiles`.
+pub fn keep_profiles() {
+    KEEP_PROFILES.store(true, Ordering::Relaxed);
+}
+
+/// The profiles of the steps taken since `keep_profiles` or the last call, in order.
+pub fn take_profiles() -> Vec<Profile> {
+    std::mem::take(&mut PROFILES.lock().expect("no step panicked"))
+}
+
+/// One step, its profile kept if asked (`keep_profiles`).
+fn step(w: &mut PhysicsWorld) {
+    w.step();
+    if KEEP_PROFILES.load(Ordering::Relaxed) {
+        let c = &w.physics_pipeline.counters;
+        let us = |t: &rapier2d::counters::Timer| 1e6 * t.time().as_secs_f64();
+        let profile = Profile {
+            step: us(&c.step_time),
+            broad_phase: us(&c.cd.broad_phase_time) + us(&c.cd.final_broad_phase_time),
+            narrow_phase: us(&c.cd.narrow_phase_time),
+            islands: us(&c.stages.island_construction_time),
+            update: us(&c.stages.update_time),
+            assembly: us(&c.solver.velocity_assembly_time),
+            resolution: us(&c.solver.velocity_resolution_time),
+            ccd: us(&c.stages.ccd_time),
+        };
+        PROFILES.lock().expect("no step panicked").push(profile);
+    }
 }
 
 /// Rapier's default solver iterations per step.
@@ -31,6 +86,9 @@ fn world(h: f64, iterations: usize) -> PhysicsWorld {
     w.gravity = Vector::new(0.0, -G as Real);
     w.integration_parameters.dt = h as Real;
     w.integration_parameters.num_solver_iterations = iterations;
+    if KEEP_PROFILES.load(Ordering::Relaxed) {
+        w.physics_pipeline.counters.enable();
+    }
     w
 }
 
@@ -74,7 +132,7 @@ pub fn pyramid(spec: &Pyramid, h: f64, iterations: usize) -> Outcome {
         })
         .collect();
     let mut tracker = PyramidTracker::new(centres);
-    let timing = measure(&mut w, spec.steps, PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, spec.steps, step, |w, _| {
         tracker.update(boxes.iter().map(|&b| centre(w, b)))
     });
     Outcome::new(timing, tracker.finish())
@@ -115,7 +173,7 @@ pub fn pendulum(spec: &Pendulum, iterations: usize) -> Outcome {
         .local_anchor2(-point(start));
     let pin = w.insert_impulse_joint(pivot, bob, pin);
     let mut tracker = PeriodTracker::new(spec.h, centre(&w, bob).0, energy(&w, bob));
-    let timing = measure(&mut w, spec.steps(), PhysicsWorld::step, |w, n| {
+    let timing = measure(&mut w, spec.steps(), step, |w, n| {
         tracker.update(n, centre(w, bob).0, energy(w, bob), joint_gap(w, pin))
     });
     Outcome::new(timing, tracker.finish())
@@ -160,7 +218,7 @@ pub fn heavy_chain(h: f64, iterations: usize) -> Outcome {
         previous = (body, c);
     }
     let mut worst_gap: f64 = 0.0;
-    let timing = measure(&mut w, chain::steps(h), PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, chain::steps(h), step, |w, _| {
         for &j in &joints {
             worst_gap = worst(worst_gap, joint_gap(w, j));
         }
@@ -178,7 +236,7 @@ pub fn bounce(h: f64, iterations: usize) -> Outcome {
         .restitution(bounce::RESTITUTION as Real);
     let (body, _) = w.insert(dynamic((0.0, bounce::DROP + half)), shape);
     let mut tracker = ReboundTracker::default();
-    let timing = measure(&mut w, bounce::steps(h), PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, bounce::steps(h), step, |w, _| {
         let v_up = f64::from(w.bodies[body].linvel().y);
         tracker.update(centre(w, body).1 - half, v_up);
     });
@@ -219,7 +277,7 @@ pub fn smash() -> Outcome {
         |w: &PhysicsWorld| momentum_and_kinetic_energy(bodies.iter().map(|&b| motion(w, b)));
     let (p0, e0) = totals(&w);
     let mut tracker = SmashTracker::new(p0, e0);
-    let timing = measure(&mut w, smash::STEPS, PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, smash::STEPS, step, |w, _| {
         let (p, e) = totals(w);
         tracker.update(p, e, smash_poses(w, &bodies));
     });
@@ -253,7 +311,7 @@ pub fn joint_grid() -> Outcome {
         })
         .collect();
     let mut worst_gap: f64 = 0.0;
-    let timing = measure(&mut w, joint_grid::STEPS, PhysicsWorld::step, |w, _| {
+    let timing = measure(&mut w, joint_grid::STEPS, step, |w, _| {
         for &j in &joints {
             worst_gap = worst(worst_gap, joint_gap(w, j));
         }
