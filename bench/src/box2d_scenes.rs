@@ -5,7 +5,7 @@
 //! that every body is simulated on every step, as in pe and rapier2d here.
 
 use crate::Outcome;
-use crate::harness::measure;
+use crate::harness::{ProfileLog, measure};
 use crate::scene::{
     BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, PeerBody, Pendulum, PeriodTracker, Pyramid,
     PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid,
@@ -14,8 +14,6 @@ use crate::scene::{
 use boxdd::{
     BodyBuilder, BodyId, BodyType, Profile, ShapeDef, SurfaceMaterial, Vec2, World, WorldDef,
 };
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Box2D's default substep count for `b2World_Step`.
 pub const SUBSTEPS: i32 = 4;
@@ -34,25 +32,13 @@ fn world() -> World {
 
 fn step(w: &mut World, h: f64, substeps: i32) {
     w.step(h as f32, substeps);
-    if KEEP_PROFILES.load(Ordering::Relaxed) {
-        PROFILES.lock().expect("no step panicked").push(w.profile());
+    if PROFILES.keeping() {
+        PROFILES.push(w.profile());
     }
 }
 
-/// Whether `step` keeps Box2D v3's own timing of each step (`b2World_GetProfile`), for
-/// `stages` to set beside pe's stage clock.
-static KEEP_PROFILES: AtomicBool = AtomicBool::new(false);
-static PROFILES: Mutex<Vec<Profile>> = Mutex::new(Vec::new());
-
-/// From now on, every step's profile is kept, until `take_profiles`.
-pub fn keep_profiles() {
-    KEEP_PROFILES.store(true, Ordering::Relaxed);
-}
-
-/// The profiles of the steps taken since `keep_profiles` or the last call, in order.
-pub fn take_profiles() -> Vec<Profile> {
-    std::mem::take(&mut PROFILES.lock().expect("no step panicked"))
-}
+/// Box2D v3's own timing of each step (`b2World_GetProfile`), for `stages`.
+pub static PROFILES: ProfileLog<Profile> = ProfileLog::new();
 
 /// A box of full size `w` × `h` on a new body; Box2D mixes friction by the geometric mean
 /// and restitution by the maximum.

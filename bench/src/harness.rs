@@ -9,7 +9,7 @@
 //! machine, and the ratios hold within a few percent.
 
 use std::cell::RefCell;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
@@ -265,6 +265,44 @@ fn median(samples: &mut [Duration]) -> Duration {
         samples[mid]
     } else {
         (samples[mid - 1] + samples[mid]) / 2
+    }
+}
+
+/// A peer's own timing of each of its steps (its profile), kept for `stages` to set beside
+/// pe's stage clock: nothing is kept until `keep`, then every step's until `take`.
+pub struct ProfileLog<T> {
+    keeping: AtomicBool,
+    profiles: Mutex<Vec<T>>,
+}
+
+impl<T> ProfileLog<T> {
+    pub const fn new() -> Self {
+        Self {
+            keeping: AtomicBool::new(false),
+            profiles: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// From now on, every step's profile is kept, until `take`.
+    pub fn keep(&self) {
+        self.keeping.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether profiles are being kept: a step asks before it reads its own.
+    pub fn keeping(&self) -> bool {
+        self.keeping.load(Ordering::Relaxed)
+    }
+
+    pub fn push(&self, profile: T) {
+        self.profiles
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(profile);
+    }
+
+    /// The profiles of the steps taken since `keep` or the last call, in order.
+    pub fn take(&self) -> Vec<T> {
+        std::mem::take(&mut self.profiles.lock().unwrap_or_else(PoisonError::into_inner))
     }
 }
 

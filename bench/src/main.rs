@@ -335,12 +335,12 @@ fn run_stages_beside_peers() {
     let pe_run = jobs.swap_remove(0)();
     let pe_steps = stage_clock::take_steps();
     let ticks_per_microsecond = stage_clock::ticks_per_microsecond().expect("enabled");
-    rapier_scenes::keep_profiles();
+    rapier_scenes::PROFILES.keep();
     rapier_job();
-    let rapier = rapier_scenes::take_profiles();
-    box2d_scenes::keep_profiles();
+    let rapier = rapier_scenes::PROFILES.take();
+    box2d_scenes::PROFILES.keep();
     box2d_job();
-    let box2d = box2d_scenes::take_profiles();
+    let box2d = box2d_scenes::PROFILES.take();
     let median = |mut values: Vec<f64>| {
         values.sort_by(f64::total_cmp);
         values[values.len() / 2]

@@ -3,15 +3,13 @@
 //! feature set); results are widened to f64 for the shared trackers.
 
 use crate::Outcome;
-use crate::harness::measure;
+use crate::harness::{ProfileLog, measure};
 use crate::scene::{
     BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, PeerBody, Pendulum, PeriodTracker, Pyramid,
     PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid,
     momentum_and_kinetic_energy, smash, worst,
 };
 use rapier2d::prelude::*;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A scene point as rapier's vector type.
 fn point((x, y): (f64, f64)) -> Vector {
@@ -42,24 +40,13 @@ pub struct Profile {
     pub ccd: f64,
 }
 
-/// Whether `step` keeps each step's `Profile`.
-static KEEP_PROFILES: AtomicBool = AtomicBool::new(false);
-static PROFILES: Mutex<Vec<Profile>> = Mutex::new(Vec::new());
+/// rapier2d's own timing of each step, for `stages`.
+pub static PROFILES: ProfileLog<Profile> = ProfileLog::new();
 
-/// From now on, every step's profile is kept, until `take_profiles`.
-pub fn keep_profiles() {
-    KEEP_PROFILES.store(true, Ordering::Relaxed);
-}
-
-/// The profiles of the steps taken since `keep_profiles` or the last call, in order.
-pub fn take_profiles() -> Vec<Profile> {
-    std::mem::take(&mut PROFILES.lock().expect("no step panicked"))
-}
-
-/// One step, its profile kept if asked (`keep_profiles`).
+/// One step, its profile kept if asked (`PROFILES`).
 fn step(w: &mut PhysicsWorld) {
     w.step();
-    if KEEP_PROFILES.load(Ordering::Relaxed) {
+    if PROFILES.keeping() {
         let c = &w.physics_pipeline.counters;
         let us = |t: &rapier2d::counters::Timer| 1e6 * t.time().as_secs_f64();
         let profile = Profile {
@@ -72,7 +59,7 @@ fn step(w: &mut PhysicsWorld) {
             resolution: us(&c.solver.velocity_resolution_time),
             ccd: us(&c.stages.ccd_time),
         };
-        PROFILES.lock().expect("no step panicked").push(profile);
+        PROFILES.push(profile);
     }
 }
 
@@ -86,7 +73,7 @@ fn world(h: f64, iterations: usize) -> PhysicsWorld {
     w.gravity = Vector::new(0.0, -G as Real);
     w.integration_parameters.dt = h as Real;
     w.integration_parameters.num_solver_iterations = iterations;
-    if KEEP_PROFILES.load(Ordering::Relaxed) {
+    if PROFILES.keeping() {
         w.physics_pipeline.counters.enable();
     }
     w
