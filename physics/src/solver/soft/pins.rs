@@ -392,8 +392,8 @@ impl<L: Lanes> BatchLanes<PinPass> for PinBatch<L> {
             let speed = (bias[0] * bias[0] + bias[1] * bias[1]).sqrt();
             let max_push = L::splat(pass.max_push);
             let too_fast = speed.gt(max_push);
-            // Only where a lane is too fast: a division a lane is slow, and a pin held
-            // together needs none.
+            // The cap divides in every lane, which is slow; it is computed only when some
+            // lane pulls too fast, and a net held together has none.
             let bias = if too_fast.any() {
                 let cap = max_push / speed;
                 [
