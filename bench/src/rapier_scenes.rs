@@ -32,10 +32,11 @@ pub struct Profile {
     pub islands: f64,
     /// Bodies and forces updated before the solve (`update_time`).
     pub update: f64,
-    /// The contact and joint constraints built (`velocity_assembly_time`).
+    /// The solver's serial set-up before its passes: buffers, the chunk layout of its
+    /// persistent colours, the joints' constraints (`velocity_assembly_time`).
     pub assembly: f64,
-    /// The solver's passes with their integration and the impulses written back
-    /// (`velocity_resolution_time`).
+    /// The contact constraints built, the passes with their integration, and impulses and
+    /// bodies written back (`velocity_resolution_time`).
     pub resolution: f64,
     pub ccd: f64,
 }
