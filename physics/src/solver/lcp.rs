@@ -25,8 +25,42 @@ pub struct LcpProblem<'a> {
     pub b: &'a [f64],
     pub lo: &'a [f64],
     pub hi: &'a [f64],
-    /// Per row: `Some((j, μ))` makes the bounds `±μ·x_j` (then `lo`/`hi` are ignored).
-    pub friction_index: Option<&'a [Option<(usize, f64)>]>,
+    /// Per row: `Some(bound)` makes the bounds `±μ` times the normal rows' impulses (then
+    /// `lo`/`hi` are ignored).
+    pub friction_index: Option<&'a [Option<FrictionBound>]>,
+}
+
+/// A friction row's bounds: `±μ` times the impulse of one normal row, or of two summed
+/// (one friction row for both points of a face contact).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrictionBound {
+    pub mu: f64,
+    pub normal: usize,
+    pub second_normal: Option<usize>,
+}
+
+impl FrictionBound {
+    pub fn single(normal: usize, mu: f64) -> Self {
+        Self {
+            mu,
+            normal,
+            second_normal: None,
+        }
+    }
+
+    pub fn shared(normal: usize, second_normal: usize, mu: f64) -> Self {
+        Self {
+            mu,
+            normal,
+            second_normal: Some(second_normal),
+        }
+    }
+
+    /// `μ` times the (non-negative part of the) normal impulses, given each row's impulse.
+    pub fn bound(&self, impulse: impl Fn(usize) -> f64) -> f64 {
+        let second = self.second_normal.map_or(0.0, |k| impulse(k).max(0.0));
+        self.mu * (impulse(self.normal).max(0.0) + second)
+    }
 }
 
 /// How a problem was solved.
@@ -43,8 +77,13 @@ pub enum LcpMethod {
 pub struct LcpStats {
     pub method: LcpMethod,
     pub pivots: usize,
-    /// Friction-index rounds solved by keeping the last round's sets, without pivoting.
+    /// Friction-index rounds: all of them, and those solved by keeping the last round's
+    /// sets, without pivoting.
+    pub rounds: usize,
     pub reused_sets: usize,
+    /// Whether the rounds stopped at the pivot budget (`PIVOT_BUDGET_PER_ROW`) before
+    /// their bounds settled.
+    pub over_budget: bool,
     /// Largest violation of bounds or complementarity, relative to the problem's scale; NaN
     /// from `solve_again`, whose callers (the soft step's passes) do not report it.
     pub residual: f64,
@@ -78,16 +117,28 @@ pub struct LcpSolver {
     dw: Vec<f64>,
     rhs: Vec<f64>,
     previous: Vec<f64>,
+    /// The round before `previous`'s solution (damped friction bounds).
+    older: Vec<f64>,
     /// Whether `set`, `clamped` and `factor` are the last solution's (`solve_again`).
     sets_valid: bool,
 }
 
-/// Regularisation added to `A_CC`'s diagonal (after scaling the diagonal is 1): redundant
-/// contacts make `A_CC` singular, and this keeps the factor finite while changing `w` by
-/// at most 1e-12·|x|.
+/// Regularisation added to the diagonal of the scaled `A` (where the diagonal is 1):
+/// redundant contacts make `A_CC` singular, and this keeps it positive definite while
+/// changing `w` by 1e-12·|x|. It is in `A` itself, so that the factor and `w` agree: added
+/// to the factor alone, a solve with the last sets disagreed with the pivoting that found
+/// them, and every friction round pivoted again (the overlap-recovery pyramid: 2,900
+/// pivots a step instead of 300).
 const REGULARISATION: f64 = 1e-12;
-/// Friction-index rounds before giving up on a fixed point.
+/// Friction-index rounds before giving up on a fixed point, and the relative change of
+/// the impulses at which they stop.
 const FRICTION_ROUNDS: usize = 30;
+const ROUND_TOLERANCE: f64 = 1e-10;
+/// Pivots per row that the friction rounds may spend together; once past, the last
+/// round's solution stands. One pivot costs about as much as a soft step of the island
+/// (`O(rows × clamped)` against `O(rows × substeps)`), so this bounds the exact solve of an
+/// island at a few soft steps' worth per row.
+const PIVOT_BUDGET_PER_ROW: usize = 4;
 /// Projected Gauss–Seidel sweeps of the fallback, and the change (in scaled impulse units,
 /// where the diagonal is 1) below which it stops early.
 const PGS_SWEEPS: usize = 200;
@@ -96,7 +147,14 @@ const PGS_TOLERANCE: f64 = 1e-10;
 impl LcpSolver {
     /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
     pub fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
-        let mut stats = self.solve_from(p, x, false);
+        self.solve_guessing(p, &[], x)
+    }
+
+    /// `solve`, with the friction rows' first bounds taken from `guess` (say, the last
+    /// step's impulses) instead of from zero, so that the rounds start near the fixed
+    /// point. An empty `guess` is zero.
+    pub fn solve_guessing(&mut self, p: &LcpProblem, guess: &[f64], x: &mut Vec<f64>) -> LcpStats {
+        let mut stats = self.solve_from(p, x, false, guess);
         if stats.method != LcpMethod::Rejected {
             stats.residual = complementarity_residual(p, x);
         }
@@ -110,10 +168,16 @@ impl LcpSolver {
     /// random throws (`physics/tests/support/random_throws.rs`).
     pub fn solve_again(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
         let warm = self.sets_valid && self.b.len() == p.n;
-        self.solve_from(p, x, warm)
+        self.solve_from(p, x, warm, &[])
     }
 
-    fn solve_from(&mut self, p: &LcpProblem, x: &mut Vec<f64>, warm: bool) -> LcpStats {
+    fn solve_from(
+        &mut self,
+        p: &LcpProblem,
+        x: &mut Vec<f64>,
+        warm: bool,
+        guess: &[f64],
+    ) -> LcpStats {
         let n = p.n;
         self.sets_valid = false;
         x.clear();
@@ -122,9 +186,8 @@ impl LcpSolver {
         if !finite(&p.a[..n * n]) || !finite(&p.b[..n]) {
             return LcpStats {
                 method: LcpMethod::Rejected,
-                pivots: 0,
-                reused_sets: 0,
                 residual: f64::INFINITY,
+                ..LcpStats::default()
             };
         }
         if warm {
@@ -146,12 +209,22 @@ impl LcpSolver {
             // Warm, `x` keeps the last solution (scaled): it bounds the friction rows.
             self.x.clear();
             self.x.resize(n, 0.0);
+            if guess.len() == n && guess.iter().all(|v| v.is_finite()) {
+                for ((x, g), scale) in self.x.iter_mut().zip(guess).zip(&self.scale) {
+                    *x = g / scale;
+                }
+            }
         }
         let mut method = LcpMethod::Pivoting;
-        let mut pivoted = warm;
+        // A guess gives the first round's sets too; `solve_again` keeps the last ones.
+        let mut pivoted =
+            warm || (has_friction_rows && guess.len() == n && self.take_sets_from_x(p));
+        let budget = PIVOT_BUDGET_PER_ROW * n + 10;
+        let (mut damped, mut last_change) = (false, f64::INFINITY);
         for _ in 0..rounds {
+            stats.rounds += 1;
             self.previous.clone_from(&self.x);
-            self.update_friction_bounds(p);
+            self.update_friction_bounds(p, damped);
             // A round after the first starts from the last round's sets: the bounds
             // moved a little, and usually the same indices stay clamped.
             if pivoted && self.solve_with_last_sets() {
@@ -172,9 +245,21 @@ impl LcpSolver {
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             let size = self.x.iter().map(|v| v.abs()).fold(0.0, f64::max);
-            if change <= 1e-12 * size.max(1e-300) {
+            if change <= ROUND_TOLERANCE * size.max(1e-300) {
                 break;
             }
+            // Each round's solution is exact for its bounds; past the budget, the last one
+            // stands, its friction bounded by the round before's normals.
+            if stats.pivots > budget {
+                stats.over_budget = true;
+                break;
+            }
+            // A fixed point that does not contract (the arch's alternated between 61 and
+            // 67 clamped rows, round after round) is damped from then on: the bounds
+            // follow the mean of the last two rounds' normals.
+            damped |= change > 0.5 * last_change;
+            last_change = change;
+            std::mem::swap(&mut self.older, &mut self.previous);
         }
         for ((out, scaled), scale) in x.iter_mut().zip(&self.x).zip(&self.scale).take(n) {
             *out = scaled * scale;
@@ -218,10 +303,7 @@ impl LcpSolver {
         for (k, &i) in self.clamped.iter().enumerate() {
             self.x[i] = self.rhs[k];
         }
-        for i in 0..n {
-            let row = &self.a[i * n..(i + 1) * n];
-            self.w[i] = self.b[i] + row.iter().zip(&self.x).map(|(a, x)| a * x).sum::<f64>();
-        }
+        self.compute_w();
         let scale = 1.0 + self.b.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let tolerance = 1e-9 * scale;
         let valid = (0..n).all(|i| match self.set[i] {
@@ -229,6 +311,7 @@ impl LcpSolver {
                 self.x[i].is_finite()
                     && self.x[i] >= self.lo[i] - tolerance
                     && self.x[i] <= self.hi[i] + tolerance
+                    && self.w[i].abs() <= tolerance
             }
             Set::Lower => self.w[i] >= -tolerance || self.lo[i] == self.hi[i],
             Set::Upper => self.w[i] <= tolerance || self.lo[i] == self.hi[i],
@@ -241,6 +324,47 @@ impl LcpSolver {
             self.x[i] = self.x[i].clamp(self.lo[i], self.hi[i]);
         }
         true
+    }
+
+    /// Guesses the sets from `x` (a guess of the solution, scaled): each index at a bound
+    /// where `x` is there, clamped between; and factors `A_CC` for them. The first round
+    /// then tries them before it pivots (`solve_with_last_sets`): at rest, last step's
+    /// impulses give this step's sets, and a solve costs one factorisation instead of a
+    /// pivot per clamped index. False if the factor failed.
+    fn take_sets_from_x(&mut self, p: &LcpProblem) -> bool {
+        let n = self.b.len();
+        self.update_friction_bounds(p, false);
+        self.w.resize(n, 0.0);
+        self.set.clear();
+        self.clamped.clear();
+        self.factor.clear();
+        self.factor.resize(n * n, 0.0);
+        for i in 0..n {
+            let (lo, hi, x) = (self.lo[i], self.hi[i], self.x[i]);
+            let tolerance = 1e-9 * x.abs();
+            self.set.push(if lo == hi || x <= lo + tolerance {
+                Set::Lower
+            } else if x >= hi - tolerance {
+                Set::Upper
+            } else {
+                Set::Unprocessed
+            });
+        }
+        for i in 0..n {
+            if self.set[i] == Set::Unprocessed && !self.join_clamped(i) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// `w = A x + b`.
+    fn compute_w(&mut self) {
+        let n = self.b.len();
+        for i in 0..n {
+            let row = &self.a[i * n..(i + 1) * n];
+            self.w[i] = self.b[i] + row.iter().zip(&self.x).map(|(a, x)| a * x).sum::<f64>();
+        }
     }
 
     /// `b`, `lo` and `hi`, scaled as the last `load_scaled` scaled the matrix.
@@ -268,17 +392,33 @@ impl LcpSolver {
         self.a.clear();
         self.a
             .extend((0..n * n).map(|k| self.scale[k / n] * p.a[k] * self.scale[k % n]));
+        for i in 0..n {
+            let bounded = p.lo[i].is_finite() || p.hi[i].is_finite();
+            if bounded || p.friction_index.is_some_and(|f| f[i].is_some()) {
+                self.a[i * n + i] += REGULARISATION;
+            }
+        }
         self.load_vectors(p);
     }
 
     /// Friction rows take their bounds from the current normal impulses (in scaled units).
-    fn update_friction_bounds(&mut self, p: &LcpProblem) {
+    /// Friction rows take their bounds from the normal impulses of `x`, or (`damped`) of
+    /// the mean of `x` and the round before's (`older`).
+    fn update_friction_bounds(&mut self, p: &LcpProblem, damped: bool) {
         let Some(index) = p.friction_index else {
             return;
         };
+        let (x, older, scale) = (&self.x, &self.older, &self.scale);
+        let impulse = |j: usize| {
+            if damped {
+                0.5 * (x[j] + older[j]) * scale[j]
+            } else {
+                x[j] * scale[j]
+            }
+        };
         for (i, f) in index.iter().enumerate().take(p.n) {
-            if let Some((j, mu)) = *f {
-                let bound = mu * (self.x[j] * self.scale[j]).max(0.0) / self.scale[i];
+            if let Some(f) = f {
+                let bound = f.bound(impulse) / self.scale[i];
                 self.lo[i] = -bound;
                 self.hi[i] = bound;
             }
@@ -299,7 +439,8 @@ impl LcpSolver {
         self.factor.resize(n * n, 0.0);
         self.dx.resize(n, 0.0);
         self.dw.resize(n, 0.0);
-        let cap = 10 * n + 10;
+        // The cap is per call: each friction round pivots afresh.
+        let cap = *pivots + 10 * n + 10;
         for d in 0..n {
             if self.lo[d] == self.hi[d] {
                 self.x[d] = self.lo[d];
@@ -447,7 +588,12 @@ impl LcpSolver {
             self.factor[m * n + k] = sum / self.factor[k * n + k];
         }
         let row_norm: f64 = (0..m).map(|c| self.factor[m * n + c].powi(2)).sum();
-        let pivot = self.a[j * n + j] + REGULARISATION - row_norm;
+        // Equality rows (unbounded both ways: pins) are not regularised in `A`, where
+        // 1e-12 of compliance would loosen a heavy chain; their factor still is, as a
+        // floor for a singular set of them.
+        let equality = self.lo[j] == f64::NEG_INFINITY && self.hi[j] == f64::INFINITY;
+        let floor = if equality { REGULARISATION } else { 0.0 };
+        let pivot = self.a[j * n + j] + floor - row_norm;
         self.factor[m * n + m] = pivot.max(REGULARISATION).sqrt();
         self.clamped.push(j);
         self.set[j] = Set::Clamped;
@@ -522,8 +668,8 @@ impl LcpSolver {
         for _ in 0..PGS_SWEEPS {
             let mut change: f64 = 0.0;
             for i in 0..n {
-                if let Some(Some((j, mu))) = p.friction_index.map(|f| f[i]) {
-                    let bound = mu * (self.x[j] * self.scale[j]).max(0.0) / self.scale[i];
+                if let Some(Some(f)) = p.friction_index.map(|f| f[i]) {
+                    let bound = f.bound(|j| self.x[j] * self.scale[j]) / self.scale[i];
                     self.lo[i] = -bound;
                     self.hi[i] = bound;
                 }
@@ -565,7 +711,7 @@ pub fn complementarity_residual(p: &LcpProblem, x: &[f64]) -> f64 {
     for i in 0..n {
         let w: f64 = (0..n).map(|j| p.a[i * n + j] * x[j]).sum::<f64>() + p.b[i];
         let (lo, hi) = match p.friction_index.and_then(|f| f[i]) {
-            Some((j, mu)) => (-mu * x[j].max(0.0), mu * x[j].max(0.0)),
+            Some(f) => (-f.bound(|j| x[j]), f.bound(|j| x[j])),
             None => (p.lo[i], p.hi[i]),
         };
         let tol = 1e-12 * scale;

@@ -6,7 +6,7 @@ use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
 use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
-use super::lcp::{LcpProblem, LcpSolver, LcpStats};
+use super::lcp::{FrictionBound, LcpProblem, LcpSolver, LcpStats};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
@@ -81,6 +81,7 @@ pub struct SimultaneousSolver {
     /// Each row's `A_ii`, for the row-by-row Gauss–Seidel.
     diagonals: Vec<f64>,
     stage_one: Vec<f64>,
+    normal_ordinal: Vec<usize>,
     island_contacts: Vec<(u32, Contact)>,
     island_joints: Vec<JointConstraint>,
     joint_slots: Vec<u32>,
@@ -89,7 +90,7 @@ pub struct SimultaneousSolver {
     b: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
-    friction_index: Vec<Option<(usize, f64)>>,
+    friction_index: Vec<Option<FrictionBound>>,
     x: Vec<f64>,
     lcp: LcpSolver,
     pub reports: Vec<IslandReport>,
@@ -130,6 +131,9 @@ impl SimultaneousSolver {
             self.guess.push(match row.kind {
                 RowKind::ContactNormal(i) => self.recalled[i as usize].0,
                 RowKind::ContactTangent(i) => self.recalled[i as usize].1,
+                RowKind::SharedTangent(i, j) => {
+                    self.recalled[i as usize].1 + self.recalled[j as usize].1
+                }
                 _ => 0.0,
             });
         }
@@ -277,17 +281,18 @@ impl SimultaneousSolver {
         self.solve_rows(bodies, false);
         std::mem::swap(&mut self.stage_one, &mut self.x);
         velocity_rows(&self.island_contacts, &[], bodies, targets, &mut self.rows);
-        let mut normal = 0;
+        // Stage one's rows are stage two's normal rows, in order: each row's normal's
+        // place among them.
+        self.normal_ordinal.clear();
+        let mut normals = 0;
+        for row in &self.rows {
+            self.normal_ordinal.push(normals);
+            normals += usize::from(matches!(row.kind, RowKind::ContactNormal(_)));
+        }
         for row in self.rows.iter_mut() {
-            match row.kind {
-                RowKind::ContactNormal(_) => normal += 1,
-                RowKind::ContactTangent(_) => {
-                    let mu = row.friction_of.map_or(0.0, |(_, mu)| mu);
-                    let bound = mu * self.stage_one[normal - 1];
-                    (row.lo, row.hi) = (-bound, bound);
-                    row.friction_of = None;
-                }
-                _ => {}
+            if let Some(f) = row.friction_of.take() {
+                let bound = f.bound(|k| self.stage_one[self.normal_ordinal[k]]);
+                (row.lo, row.hi) = (-bound, bound);
             }
         }
         self.solve_rows(bodies, true);
@@ -301,9 +306,7 @@ impl SimultaneousSolver {
             targets,
             &mut self.rows,
         );
-        if self.rows.len() > self.dense_row_limit {
-            self.remember();
-        }
+        self.remember();
         self.solve_rows(bodies, true);
         self.guess.clear();
     }
@@ -360,7 +363,7 @@ impl SimultaneousSolver {
             hi: &self.hi,
             friction_index: Some(&self.friction_index),
         };
-        self.lcp.solve(&problem, &mut self.x)
+        self.lcp.solve_guessing(&problem, &self.guess, &mut self.x)
     }
 
     /// Projected Gauss–Seidel on the rows themselves, for islands too big for a dense
@@ -407,8 +410,8 @@ impl SimultaneousSolver {
                     continue;
                 }
                 let (lo, hi) = match row.friction_of {
-                    Some((j, mu)) => {
-                        let bound = mu * self.x[j].max(0.0);
+                    Some(f) => {
+                        let bound = f.bound(|k| self.x[k]);
                         (-bound, bound)
                     }
                     None => (row.lo, row.hi),
@@ -436,6 +439,18 @@ impl SimultaneousSolver {
             match row.kind {
                 RowKind::ContactNormal(i) => contacts[i as usize].normal_impulse = x,
                 RowKind::ContactTangent(i) => contacts[i as usize].tangent_impulse = x,
+                RowKind::SharedTangent(i, j) => {
+                    // Shared as the normals are (halves when neither pushes).
+                    let (i, j) = (i as usize, j as usize);
+                    let (n_i, n_j) = (contacts[i].normal_impulse, contacts[j].normal_impulse);
+                    let share = if n_i + n_j > 0.0 {
+                        n_i / (n_i + n_j)
+                    } else {
+                        0.5
+                    };
+                    contacts[i].tangent_impulse = x * share;
+                    contacts[j].tangent_impulse = x - x * share;
+                }
                 RowKind::JointMotor(k) => {
                     let slot = self.joint_slots[k as usize] as usize;
                     if let Some(m) = joints[slot].motor.as_mut() {

@@ -12,7 +12,7 @@ use super::contact::{Contact, ContactMemory};
 use super::envelope::EnvelopeCholesky;
 use super::island::IslandGrouping;
 use super::joint::JointConstraint;
-use super::lcp::{LcpMethod, LcpProblem, LcpSolver};
+use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
@@ -2049,7 +2049,7 @@ struct ContactLcp {
     b: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
-    friction_index: Vec<Option<(usize, f64)>>,
+    friction_index: Vec<Option<FrictionBound>>,
     x: Vec<f64>,
     /// A solver per island: the passes after the step's first solve the same matrix
     /// again, and start from the last pass's sets (`LcpSolver::solve_again`).
@@ -2193,7 +2193,7 @@ impl ContactLcp {
                     self.lo.push(0.0);
                     self.hi.push(0.0);
                     self.friction_index
-                        .extend([None, Some((2 * i, p.friction))]);
+                        .extend([None, Some(FrictionBound::single(2 * i, p.friction))]);
                 }
             }
             for r in 0..n {

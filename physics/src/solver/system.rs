@@ -7,6 +7,7 @@
 use super::SolverBody;
 use super::contact::Contact;
 use super::joint::JointConstraint;
+use super::lcp::FrictionBound;
 use crate::math::{Vec2, cross};
 
 /// One body's part of a row: the row's velocity is `linear·v + angular·ω` summed over both.
@@ -22,6 +23,8 @@ pub struct RowEnd {
 pub enum RowKind {
     ContactNormal(u32),
     ContactTangent(u32),
+    /// The one friction row of a face contact's two points (see `velocity_rows`).
+    SharedTangent(u32, u32),
     JointX(u32),
     JointY(u32),
     JointMotor(u32),
@@ -34,8 +37,8 @@ pub struct Row {
     pub b: f64,
     pub lo: f64,
     pub hi: f64,
-    /// For a friction row: the normal row whose impulse bounds it, and μ.
-    pub friction_of: Option<(usize, f64)>,
+    /// For a friction row: the normal rows whose impulses bound it, and μ.
+    pub friction_of: Option<FrictionBound>,
 }
 
 impl Row {
@@ -117,33 +120,59 @@ pub fn velocity_rows(
     rows: &mut Vec<Row>,
 ) {
     rows.clear();
-    for &(index, c) in contacts {
-        let normal_row = rows.len();
-        let ends = point_row(c.body_a, c.body_b, c.point, c.point, c.normal, bodies);
-        let mut row = Row {
-            kind: RowKind::ContactNormal(index),
-            ends,
-            b: 0.0,
-            lo: 0.0,
-            hi: f64::INFINITY,
-            friction_of: None,
-        };
-        let v_n = row.velocity(bodies);
-        row.b = v_n - c.min_normal_velocity(targets.dt, targets.bounce_below);
-        rows.push(row);
+    let mut k = 0;
+    while k < contacts.len() {
+        // A manifold's points come one after another, on one normal.
+        let (index, c) = contacts[k];
+        let shares_face = contacts.get(k + 1).is_some_and(|&(_, d)| {
+            (d.body_a, d.body_b) == (c.body_a, c.body_b) && d.normal == c.normal
+        });
+        let points = if shares_face { 2 } else { 1 };
+        let first_normal = rows.len();
+        for &(index, c) in &contacts[k..k + points] {
+            let ends = point_row(c.body_a, c.body_b, c.point, c.point, c.normal, bodies);
+            let mut row = Row {
+                kind: RowKind::ContactNormal(index),
+                ends,
+                b: 0.0,
+                lo: 0.0,
+                hi: f64::INFINITY,
+                friction_of: None,
+            };
+            row.b = row.velocity(bodies) - c.min_normal_velocity(targets.dt, targets.bounce_below);
+            rows.push(row);
+        }
         if targets.friction {
-            let ends = point_row(c.body_a, c.body_b, c.point, c.point, c.tangent(), bodies);
+            // Two points on one face have the same tangent row but for the lever, which
+            // differs only by the points' offset along the normal (their depths): one row
+            // at their midpoint, bounded by μ times both normals, is the same friction
+            // without a redundant row (which made the pivoting degenerate: the arch's 92
+            // rows had rank 63).
+            let (kind, point, bound) = if shares_face {
+                let (second, d) = contacts[k + 1];
+                let bound = FrictionBound::shared(first_normal, first_normal + 1, c.friction);
+                (
+                    RowKind::SharedTangent(index, second),
+                    (c.point + d.point) * 0.5,
+                    bound,
+                )
+            } else {
+                let bound = FrictionBound::single(first_normal, c.friction);
+                (RowKind::ContactTangent(index), c.point, bound)
+            };
+            let ends = point_row(c.body_a, c.body_b, point, point, c.tangent(), bodies);
             let mut t_row = Row {
-                kind: RowKind::ContactTangent(index),
+                kind,
                 ends,
                 b: 0.0,
                 lo: 0.0,
                 hi: 0.0,
-                friction_of: Some((normal_row, c.friction)),
+                friction_of: Some(bound),
             };
             t_row.b = t_row.velocity(bodies);
             rows.push(t_row);
         }
+        k += points;
     }
     for (k, j) in joints.iter().enumerate() {
         let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
