@@ -288,9 +288,23 @@ fn speculative_points_cover_the_gap_two_bodies_can_close() {
         }
         // They meet face to face (measured: at most 1.5e-13 m in); caught a step late
         // they would sink 0.02 m. Equal masses, no restitution: both stop.
-        assert!(deepest < 1e-9, "{solver:?}: sank {deepest}");
+        assert!(
+            deepest < met_face_to_face(solver),
+            "{solver:?}: sank {deepest}"
+        );
         let v = closing.body(BodyHandle(0)).unwrap().velocity.x;
         assert!(v.abs() < 1e-12, "{solver:?}: still moving at {v}");
+    }
+}
+
+/// How deep two faces that meet at speed may sink into each other: nothing, but for the
+/// soft step, whose touching points are springs solved point by point (as Box2D v3's):
+/// one pass leaves the face turning slightly, 2.4e-5 m in at 7.2 m/s (measured).
+fn met_face_to_face(solver: ContactSolver) -> f64 {
+    if solver == ContactSolver::Soft {
+        1e-4
+    } else {
+        1e-9
     }
 }
 
@@ -325,7 +339,10 @@ fn a_body_bouncing_within_the_step_keeps_its_points_with_the_one_behind() {
         }
         // They meet face to face (measured: at most 3.8e-13 m in); with the points
         // dropped on the relative reach alone they met 0.15 m deep.
-        assert!(deepest < 1e-9, "{solver:?}: sank {deepest}");
+        assert!(
+            deepest < met_face_to_face(solver),
+            "{solver:?}: sank {deepest}"
+        );
     }
 }
 

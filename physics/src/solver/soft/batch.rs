@@ -943,6 +943,9 @@ pub(super) struct ManifoldBatch<const N: usize, L = F64x8> {
     normal_x: L,
     normal_y: L,
     friction: L,
+    /// 1 in lanes whose manifold has a fixed body (whose contacts are stiffer:
+    /// `PassSettings::static_soft`), else 0.
+    fixed: L,
     k11: L,
     k12: L,
     k22: L,
@@ -983,6 +986,7 @@ impl<const N: usize> Default for ManifoldBatch<N> {
             normal_x: zero,
             normal_y: zero,
             friction: zero,
+            fixed: zero,
             k11: zero,
             k12: zero,
             k22: zero,
@@ -1079,6 +1083,8 @@ impl<L: Lanes> LanePair<L> {
 pub(super) struct PassSettings {
     pub inv_h: f64,
     pub soft: Softness,
+    /// The softness of contacts with a fixed body.
+    pub static_soft: Softness,
     pub max_push: f64,
     pub use_bias: bool,
 }
@@ -1353,6 +1359,7 @@ impl<const N: usize> ManifoldBatch<N> {
         self.normal_x.0[k] = p.normal.x;
         self.normal_y.0[k] = p.normal.y;
         self.friction.0[k] = p.friction;
+        self.fixed.0[k] = if a.moves() && b.moves() { 0.0 } else { 1.0 };
         if N == 2 {
             let block = p.pair_coupling.expect("batched pairs are coupled");
             self.k11.0[k] = block.k11;
@@ -1489,43 +1496,48 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         separations
     }
 
-    /// A two-point manifold's normals, as `solve_pair` solves them: together, except in
-    /// lanes whose points differ in softness (one speculative, one touching), which solve
-    /// them one after the other; both are computed there, and the lane's chosen.
+    /// A two-point manifold's normals, as `solve_pair` solves them: together where both
+    /// rows are rigid (the relax pass, or both points speculative), point by point where
+    /// a row is a soft spring; in a batch with lanes of both kinds, both are computed and
+    /// each lane's chosen.
     #[inline(always)]
     fn solve_normals_together<const BIAS: bool, const BOUNCE: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         separations: &[L],
         targets: &[Target<L>],
-        pass: &PassSettings,
     ) {
         let zero = L::splat(0.0);
         let normal = (self.normal_x, self.normal_y);
-        let mixed = separations[0].gt(zero) ^ separations[1].gt(zero);
-        let soft_differs = BIAS && (pass.soft.mass_scale, pass.soft.impulse_scale) != (1.0, 0.0);
-        if !(soft_differs && mixed.any()) {
-            // Apart from the rarer case below, whose copies would take its registers.
-            self.solve_normals_as_block::<BIAS, BOUNCE>(pair, separations, targets);
+        let rigid = separations[0].gt(zero) & separations[1].gt(zero);
+        let soft = rigid ^ zero.eq(zero);
+        if !BIAS || !soft.any() {
+            self.solve_normals_as_block::<BOUNCE>(pair, separations, targets);
+            return;
+        }
+        if !rigid.any() {
+            let bounce = BOUNCE.then_some(&mut self.bounce[..]);
+            let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
+            solve_normals_alone::<L, BIAS>(pair, points, normal, separations, targets);
             return;
         }
         // Copied before the block changes them: the velocities and impulses, and the
         // bounce lanes of a batch that may bounce.
         let (mut alone, mut impulses) = (*pair, self.normal_impulses);
         let mut bounce = BOUNCE.then_some(self.bounce);
-        self.solve_normals_as_block::<BIAS, BOUNCE>(pair, separations, targets);
+        self.solve_normals_as_block::<BOUNCE>(pair, separations, targets);
         let alone_bounce = bounce.as_mut().map(|b| &mut b[..]);
         let alone_points = (&self.points[..], &mut impulses[..], alone_bounce);
         solve_normals_alone::<L, BIAS>(&mut alone, alone_points, normal, separations, targets);
-        *pair = LanePair::select(mixed, alone, *pair);
+        *pair = LanePair::select(rigid, *pair, alone);
         for (p, q) in self.normal_impulses.iter_mut().zip(impulses) {
-            p.set(mixed.select(q, *p));
+            p.set(rigid.select(*p, q));
         }
         if let Some(bounce) = bounce {
             for (p, q) in self.bounce.iter_mut().zip(bounce) {
-                let largest = mixed.select(q.max_normal_impulse, p.max_normal_impulse);
+                let largest = rigid.select(p.max_normal_impulse, q.max_normal_impulse);
                 p.max_normal_impulse.set(largest);
-                let fastest = mixed.select(q.relative_velocity, p.relative_velocity);
+                let fastest = rigid.select(p.relative_velocity, q.relative_velocity);
                 p.relative_velocity.set(fastest);
             }
         }
@@ -1534,7 +1546,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
     /// Both points' normal velocities, their approach where they may bounce, and the
     /// 2 × 2 block (`solve_block`).
     #[inline(always)]
-    fn solve_normals_as_block<const BIAS: bool, const BOUNCE: bool>(
+    fn solve_normals_as_block<const BOUNCE: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         separations: &[L],
@@ -1548,37 +1560,24 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             approach(&mut self.bounce[0], v1, separations[0]);
             approach(&mut self.bounce[1], v2, separations[1]);
         }
-        self.solve_block::<BIAS, BOUNCE>(pair, [v1, v2], [targets[0], targets[1]]);
+        self.solve_block::<BOUNCE>(pair, [v1, v2], [targets[0].0, targets[1].0]);
     }
 
     /// `solve_normal_pair` on every lane: the active set of each lane's 2 × 2 LCP chosen
-    /// by masks.
+    /// by masks. Rigid rows (the relax pass): targets `t1`, `t2`.
     #[inline(always)]
-    fn solve_block<const BIAS: bool, const BOUNCE: bool>(
+    fn solve_block<const BOUNCE: bool>(
         &mut self,
         pair: &mut LanePair<L>,
         [v1, v2]: [L; 2],
-        [(t1, ms1, s1), (t2, ms2, s2)]: [Target<L>; 2],
+        [t1, t2]: [L; 2],
     ) {
         let zero = L::splat(0.0);
         let points = &self.points[..];
         let [x1, x2] = [self.normal_impulses[0], self.normal_impulses[1]];
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
         let (kx1, kx2) = (k12.mul_add(x2, k11 * x1), k22.mul_add(x2, k12 * x1));
-        let (r1, r2) = if BIAS {
-            let spring12 = k12.min(zero);
-            let (sx1, sx2) = (
-                spring12.mul_add(x2, k11 * x1),
-                k22.mul_add(x2, spring12 * x1),
-            );
-            (
-                s1.mul_add(sx1, ms1.mul_add(v1 - t1, -kx1)),
-                s2.mul_add(sx2, ms2.mul_add(v2 - t2, -kx2)),
-            )
-        } else {
-            // Mass scale 1 and impulse scale 0 (`solve_lanes`).
-            ((v1 - t1) - kx1, (v2 - t2) - kx2)
-        };
+        let (r1, r2) = ((v1 - t1) - kx1, (v2 - t2) - kx2);
         let [i11, i12, i22] = self.inverse;
         let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
         let first = -r1 * points[0].normal_mass;
@@ -1658,15 +1657,15 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let one = L::splat(1.0);
         // `normal_target`: speculative points close their gap, touching ones are soft
         // with bias (or rigid in the relax pass).
+        let fixed = self.fixed.gt(zero);
+        let soft = |f: fn(&Softness) -> f64| {
+            fixed.select(L::splat(f(&pass.static_soft)), L::splat(f(&pass.soft)))
+        };
         let target = |s: L| {
             let speculative = s.gt(zero);
             let (target, mass_scale, impulse_scale) = if BIAS {
-                let bias = -(L::splat(pass.soft.bias_rate) * s).max(L::splat(-pass.max_push));
-                (
-                    bias,
-                    L::splat(pass.soft.mass_scale),
-                    L::splat(pass.soft.impulse_scale),
-                )
+                let bias = -(soft(|t| t.bias_rate) * s).max(L::splat(-pass.max_push));
+                (bias, soft(|t| t.mass_scale), soft(|t| t.impulse_scale))
             } else {
                 (zero, one, zero)
             };
@@ -1681,7 +1680,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             *t = target(s);
         }
         if N == 2 {
-            self.solve_normals_together::<BIAS, BOUNCE>(&mut pair, &separations, &targets, pass);
+            self.solve_normals_together::<BIAS, BOUNCE>(&mut pair, &separations, &targets);
         } else {
             let bounce = BOUNCE.then_some(&mut self.bounce[..]);
             let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
@@ -1937,6 +1936,7 @@ pub(super) mod tests {
         PassSettings {
             inv_h: 240.0,
             soft: Softness::new(30.0, 10.0, 1.0 / 240.0),
+            static_soft: Softness::new(60.0, 10.0, 1.0 / 240.0),
             max_push: 3.0,
             use_bias,
         }
