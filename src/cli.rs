@@ -56,8 +56,8 @@ pub struct RunArgs {
     /// The step in seconds (default: the scene's `timestep`, else 0.05).
     #[arg(long)]
     pub dt: Option<f64>,
-    /// The contact solver: exact, thesis, soft, auto or sequential (default: the scene's,
-    /// else exact).
+    /// The contact solver: auto, exact, soft, thesis or sequential (default: the scene's,
+    /// else auto).
     #[arg(long, value_parser = parse_solver)]
     pub solver: Option<ContactSolver>,
     /// Let bodies at rest sleep (skipped until something wakes them): faster, and the

@@ -208,6 +208,9 @@ pub struct World {
     contacts: Vec<Contact>,
     /// Per body: the island it fell asleep with (woken together).
     sleep_labels: Vec<u32>,
+    /// Per body: under `auto`, the step until which its island stays on the soft step
+    /// (`keep_over_budget_on_soft`).
+    soft_until: Vec<u64>,
     scratch: Scratch,
 }
 
@@ -231,6 +234,10 @@ enum Pipeline {
 
 /// Seconds an island must stay still before it sleeps.
 const SLEEP_AFTER: f64 = 0.5;
+
+/// Seconds an island that went over the exact solver's pivot budget stays on the soft
+/// step under `auto`.
+const SOFT_AFTER_OVER_BUDGET: f64 = 1.0;
 
 /// Buffers reused from step to step so that stepping does not allocate.
 #[derive(Debug, Clone, Default)]
@@ -293,7 +300,10 @@ struct Scratch {
     /// runs, and both passes' island reports.
     auto_links: Vec<(u32, u32, usize)>,
     island_rows: Vec<usize>,
-    in_big_island: Vec<bool>,
+    island_needs: Vec<IslandNeeds>,
+    /// Per body: whether it is kept on the soft step this step (`World::soft_until`).
+    prefer_soft: Vec<bool>,
+    in_soft_island: Vec<bool>,
     last_marking: LastMarking,
     #[cfg(test)]
     marks_kept: usize,
@@ -306,16 +316,57 @@ struct Scratch {
     candidates_current: bool,
 }
 
-/// What `auto`'s last marking of big islands was made from, and what it found: a pile at
-/// rest gives the same step after step (`World::mark_big_islands`).
+/// What `auto`'s last marking of soft islands was made from, and what it found: a pile
+/// at rest gives the same step after step (`World::mark_soft_islands`).
 #[derive(Debug, Clone, Default)]
 struct LastMarking {
     links: Vec<(u32, u32, usize)>,
     candidates: Vec<(u32, u32)>,
     fixed: Vec<bool>,
     row_limit: usize,
-    /// `(small, big)`: whether some moving body is in a small island, some in a big one.
+    prefer_soft: Vec<bool>,
+    /// `(exact, soft)`: whether some moving body is in an exact island, some in a soft
+    /// one.
     found: Option<(bool, bool)>,
+}
+
+/// What an island holds that decides whether `auto` solves it exactly.
+#[derive(Debug, Clone, Copy)]
+struct IslandNeeds {
+    /// A pin or a motor.
+    jointed: bool,
+    /// The heaviest and the lightest moving body's inverse mass (the smallest and the
+    /// largest).
+    inverse_masses: (f64, f64),
+    /// A body that went over the exact solver's pivot budget lately.
+    prefers_soft: bool,
+}
+
+impl Default for IslandNeeds {
+    fn default() -> Self {
+        Self {
+            jointed: false,
+            inverse_masses: (f64::INFINITY, 0.0),
+            prefers_soft: false,
+        }
+    }
+}
+
+/// Moving bodies whose masses differ this much make an island `auto` solves exactly: the
+/// soft step's Gauss–Seidel passes carry a heavy body's weight down a light one slowly.
+const EXACT_MASS_RATIO: f64 = 10.0;
+
+impl IslandNeeds {
+    /// A robot stays exact whatever its pivots cost: the budget bounds each step's, and
+    /// the soft step would let its pins give.
+    fn kept_on_soft(&self) -> bool {
+        self.prefers_soft && !self.jointed
+    }
+
+    fn exact_needed(&self) -> bool {
+        let (heaviest, lightest) = self.inverse_masses;
+        self.jointed || (heaviest > 0.0 && lightest >= EXACT_MASS_RATIO * heaviest)
+    }
 }
 
 /// How far two bodies can close on each other in a step, from each one's `motion`: their
@@ -1143,23 +1194,24 @@ impl World {
         }
     }
 
-    /// `auto`: islands of more than `dense_row_limit` LCP rows go to the soft step, the
-    /// rest to `exact`. Each solver's pass holds the other's bodies still. Islands are
-    /// joined by the broad phase's candidate pairs of this step, not only by last step's
-    /// contacts, so bodies that can touch during the step are in one pass: a box falling
-    /// onto a pile joins the pile's pass before it lands. (Joined by last step's contacts
-    /// only, the landing step acted one way, and the smash scene lost 0.7% of its
-    /// momentum.) Contacts and island reports of both passes are kept.
+    /// `auto`: each island goes to `exact` or to the soft step (`mark_soft_islands`).
+    /// Each solver's pass holds the other's bodies still. Islands are joined by the broad
+    /// phase's candidate pairs of this step, not only by last step's contacts, so bodies
+    /// that can touch during the step are in one pass: a box falling onto a pile joins
+    /// the pile's pass before it lands. (Joined by last step's contacts only, the landing
+    /// step acted one way, and the smash scene lost 0.7% of its momentum.) Contacts and
+    /// island reports of both passes are kept.
     fn step_auto(&mut self, dt: f64) {
-        let (small, big) = self.mark_big_islands(dt);
-        if !big {
+        let (exact, soft) = self.mark_soft_islands(dt);
+        if !soft {
             self.step_impulses(dt);
+            self.keep_over_budget_on_soft(dt);
             self.scratch
                 .auto_reports
                 .clone_from(&self.scratch.simultaneous.reports);
             return;
         }
-        if !small {
+        if !exact {
             // No body is held and none has moved: the soft step's broad phase would find
             // the candidate pairs just found.
             self.scratch.candidates_current = true;
@@ -1172,6 +1224,7 @@ impl World {
         self.hold_where(true);
         self.step_impulses(dt);
         self.release_held();
+        self.keep_over_budget_on_soft(dt);
         let s = &mut self.scratch;
         std::mem::swap(&mut s.exact_contacts, &mut self.contacts);
         std::mem::swap(&mut s.exact_manifolds, &mut self.manifolds);
@@ -1196,13 +1249,19 @@ impl World {
         self.manifolds.splice(0..0, s.exact_manifolds.drain(..));
     }
 
-    /// Marks each moving body whose island has more than `dense_row_limit` LCP rows;
-    /// islands are joined by the last step's contacts, the joints and this step's
-    /// candidate pairs. Rows: two per pin, one per motor, and the larger of two per contact
-    /// point of the last step and two per candidate pair (one point each), so that a pile
-    /// is big from its first step, before any contact is known. Returns whether some
-    /// moving body is in a small island and whether some is in a big one.
-    fn mark_big_islands(&mut self, dt: f64) -> (bool, bool) {
+    /// Marks each moving body whose island the soft step takes (`auto`). An island goes to
+    /// `exact` where exact pivoting is both needed and fast: it holds a pin or a motor, or
+    /// moving bodies whose masses differ tenfold (a robot, a heavy box on light ones),
+    /// it has at most `dense_row_limit` LCP rows, and (unless it is a robot) none of its
+    /// bodies went over the pivot budget within the last second. A pile of like bodies
+    /// goes to the soft step, as accurate there at a fraction of the cost.
+    ///
+    /// Islands are joined by the last step's contacts, the joints and this step's candidate
+    /// pairs. Rows: two per pin, one per motor, and the larger of two per contact point of
+    /// the last step and two per candidate pair (one point each), so that a pile is big
+    /// from its first step, before any contact is known. Returns whether some moving body
+    /// is in an exact island and whether some is in a soft one.
+    fn mark_soft_islands(&mut self, dt: f64) -> (bool, bool) {
         self.find_candidate_pairs(dt);
         let n = self.bodies.len();
         let bodies = &self.bodies;
@@ -1211,19 +1270,29 @@ impl World {
         let mut links: Vec<(u32, u32, usize)> = std::mem::take(&mut s.auto_links);
         links.clear();
         links.extend(self.contacts.iter().map(|c| (c.body_a, c.body_b, 2)));
+        let contact_links = links.len();
         for j in self.joints.iter().flatten() {
             let rows = 2 + usize::from(j.motor.is_some_and(|m| m.enabled));
             let b = j.body_b.map_or(j.body_a.0, |h| h.0);
             links.push((j.body_a.0, b, rows));
         }
-        // The marking is a function of its links, candidates, fixed bodies and limit alone
-        // (the fixed ones are `fat_fixed`: no body is held between passes): the same
-        // inputs, the same marks, without the union-find.
+        // A body motor is a link of the body to itself: no rows, but its island is a
+        // robot's.
+        links.extend(self.body_motors.iter().map(|(h, _)| (h.0, h.0, 0)));
+        let soft_until = &self.soft_until;
+        let step = self.step_count;
+        s.prefer_soft.clear();
+        s.prefer_soft
+            .extend((0..n).map(|i| soft_until.get(i).is_some_and(|&until| until > step)));
+        // The marking is a function of its links, candidates, fixed bodies, limit and the
+        // bodies kept on the soft step alone (the fixed ones are `fat_fixed`: no body is
+        // held between passes): the same inputs, the same marks, without the union-find.
         let limit = self.settings.dense_row_limit;
         let last = &s.last_marking;
         if let Some(marked) = last.found
             && (&last.links, &last.candidates, &last.fixed, last.row_limit)
                 == (&links, &s.pairs, &s.fat_fixed, limit)
+            && last.prefer_soft == s.prefer_soft
         {
             s.auto_links = links;
             #[cfg(test)]
@@ -1240,10 +1309,9 @@ impl World {
             }
         }
         // Per root, two counts: pins, motors and last step's contacts; pins, motors and
-        // candidate pairs. (`links` lists the contacts first, then the joints.)
+        // candidate pairs. (`links` lists the contacts first, then the joints and motors.)
         s.island_rows.clear();
         s.island_rows.resize(2 * n, 0);
-        let contact_links = self.contacts.len();
         let counted = links.iter().enumerate().map(|(k, &(a, b, rows))| {
             let columns = if k < contact_links { 0..1 } else { 0..2 };
             (a, b, rows, columns)
@@ -1258,16 +1326,38 @@ impl World {
                 }
             }
         }
+        // Per root: whether a pin or motor is in it, and its moving bodies' lightest and
+        // heaviest inverse masses.
+        s.island_needs.clear();
+        s.island_needs.resize(n, IslandNeeds::default());
+        for &(a, b, _) in &links[contact_links..] {
+            let end = if moving(a) { a } else { b };
+            if moving(end) {
+                let root = s.island_union.find(end) as usize;
+                s.island_needs[root].jointed = true;
+            }
+        }
+        for i in 0..n as u32 {
+            if let Some(body) = bodies[i as usize].as_ref().filter(|b| !b.is_fixed()) {
+                let root = s.island_union.find(i) as usize;
+                let needs = &mut s.island_needs[root];
+                needs.inverse_masses.0 = needs.inverse_masses.0.min(body.inv_mass);
+                needs.inverse_masses.1 = needs.inverse_masses.1.max(body.inv_mass);
+                needs.prefers_soft |= s.prefer_soft[i as usize];
+            }
+        }
         s.auto_links = links;
-        s.in_big_island.clear();
-        let (mut small, mut big) = (false, false);
+        s.in_soft_island.clear();
+        let (mut exact, mut soft) = (false, false);
         for i in 0..n as u32 {
             let root = s.island_union.find(i) as usize;
             let rows = s.island_rows[root].max(s.island_rows[n + root]);
-            let is_big = moving(i) && rows > self.settings.dense_row_limit;
-            s.in_big_island.push(is_big);
-            big |= is_big;
-            small |= moving(i) && !is_big;
+            let needs = &s.island_needs[root];
+            let goes_exact = needs.exact_needed() && rows <= limit && !needs.kept_on_soft();
+            let in_soft = moving(i) && !goes_exact;
+            s.in_soft_island.push(in_soft);
+            soft |= in_soft;
+            exact |= moving(i) && goes_exact;
         }
         let last = &mut s.last_marking;
         // The last links go back to be the buffer for the next marking's.
@@ -1275,18 +1365,37 @@ impl World {
         last.candidates.clone_from(&s.pairs);
         last.fixed.clone_from(&s.fat_fixed);
         last.row_limit = limit;
-        last.found = Some((small, big));
-        (small, big)
+        last.prefer_soft.clone_from(&s.prefer_soft);
+        last.found = Some((exact, soft));
+        (exact, soft)
     }
 
-    /// Holds every moving body whose island is (`big`) or is not (`!big`) big.
-    fn hold_where(&mut self, big: bool) {
+    /// The bodies of islands whose exact solve went over its pivot budget this step stay
+    /// on the soft step for the next second (`mark_soft_islands`): no island costs more
+    /// than the budget for longer than a step.
+    fn keep_over_budget_on_soft(&mut self, dt: f64) {
+        let over = &self.scratch.simultaneous.over_budget_bodies;
+        if over.is_empty() {
+            return;
+        }
+        // This step's count is `step_count` until it ends: the next second of steps.
+        let until = self.step_count + 1 + (SOFT_AFTER_OVER_BUDGET / dt).ceil() as u64;
+        self.soft_until.resize(self.bodies.len(), 0);
+        // The static world's slot comes after the bodies'.
+        for &i in over.iter().filter(|&&i| (i as usize) < self.bodies.len()) {
+            self.soft_until[i as usize] = until;
+        }
+    }
+
+    /// Holds every moving body whose island is (`soft`) or is not (`!soft`) the soft
+    /// step's.
+    fn hold_where(&mut self, soft: bool) {
         let s = &mut self.scratch;
         s.held.clear();
         for (i, body) in self.bodies.iter_mut().enumerate() {
             if let Some(b) = body
                 && !b.is_fixed()
-                && s.in_big_island[i] == big
+                && s.in_soft_island[i] == soft
             {
                 s.held.push((i as u32, b.hold()));
             }
@@ -1981,7 +2090,7 @@ mod tests {
             .collect()
     }
 
-    /// A 10-row pyramid of unit boxes (55, a big island) on a floor, under `auto`, g = 10.
+    /// A 10-row pyramid of unit boxes (55, a soft island) on a floor, under `auto`, g = 10.
     fn pyramid_under_auto() -> World {
         let mut world = World::new(Vec2::new(0.0, 10.0));
         world.settings.contact_solver = ContactSolver::Auto;
@@ -2001,17 +2110,18 @@ mod tests {
         world
     }
 
-    /// `auto` holds the big islands' bodies for its exact pass and the small ones' for its
-    /// soft pass: the broad phase keeps its pairs across the holds, and each pass's
+    /// `auto` holds the soft islands' bodies for its exact pass and the exact ones' for
+    /// its soft pass: the broad phase keeps its pairs across the holds, and each pass's
     /// candidates are exactly the overlapping pairs of which a body moves in that pass.
     #[test]
     fn candidates_leave_out_the_pairs_held_still_in_each_pass_of_auto() {
         let mut world = pyramid_under_auto();
-        // Apart from the pyramid (a big island), two stacks of two (small ones).
+        // Apart from the pyramid (a soft island), two stacks of two, each topped by a
+        // box twenty times as heavy (exact ones).
         let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
         for x in [20.0, 25.0] {
-            for y in [-0.5, -1.5] {
-                let def = BodyDef::new(unit.clone(), 1.0).at(Vec2::new(x, y), 0.1);
+            for (y, density) in [(-0.5, 1.0), (-1.5, 20.0)] {
+                let def = BodyDef::new(unit.clone(), density).at(Vec2::new(x, y), 0.1);
                 world.add_body(def).unwrap();
             }
         }
@@ -2019,13 +2129,13 @@ mod tests {
         for _ in 0..5 {
             world.step(dt);
         }
-        assert_eq!(world.mark_big_islands(dt), (true, true));
+        assert_eq!(world.mark_soft_islands(dt), (true, true));
         let unheld = world.scratch.pairs.clone();
         assert_eq!(unheld, overlapping_pairs(&world));
         let mut moving_in_pass = vec![];
-        for big in [true, false] {
+        for soft in [true, false] {
             let fat_boxes = world.scratch.fat_boxes.clone();
-            world.hold_where(big);
+            world.hold_where(soft);
             world.find_candidate_pairs(dt);
             assert_eq!(world.scratch.fat_boxes, fat_boxes, "pairs kept");
             assert_eq!(world.scratch.pairs, overlapping_pairs(&world));
@@ -2037,12 +2147,12 @@ mod tests {
         assert!(moving_in_pass.iter().all(|&n| n > 2), "{moving_in_pass:?}");
     }
 
-    /// `auto` marks the big islands again only when what the marks are made from changes:
-    /// at every step, the kept marks are the ones a fresh marking gives, through a row
-    /// limit that makes the pyramid small and back, a limit that the arm's island passes
-    /// as its motor is switched off and on, and the pyramid falling asleep.
+    /// `auto` marks the soft islands again only when what the marks are made from changes:
+    /// at every step, the kept marks are the ones a fresh marking gives, through row
+    /// limits that the arm's island passes as its motor is switched off and on, and the
+    /// pyramid falling asleep.
     #[test]
-    fn big_islands_are_marked_again_whenever_what_they_are_made_from_changes() {
+    fn soft_islands_are_marked_again_whenever_what_they_are_made_from_changes() {
         let mut world = pyramid_under_auto();
         world.settings.sleeping = true;
         // A bar on a motor, which never falls asleep.
@@ -2067,12 +2177,12 @@ mod tests {
                 }
                 _ => {}
             }
-            let kept = world.mark_big_islands(dt);
-            let kept_marks = world.scratch.in_big_island.clone();
+            let kept = world.mark_soft_islands(dt);
+            let kept_marks = world.scratch.in_soft_island.clone();
             world.scratch.last_marking.found = None;
-            let fresh = world.mark_big_islands(dt);
+            let fresh = world.mark_soft_islands(dt);
             assert_eq!(kept, fresh, "step {step}");
-            assert_eq!(kept_marks, world.scratch.in_big_island, "step {step}");
+            assert_eq!(kept_marks, world.scratch.in_soft_island, "step {step}");
             world.step(dt);
         }
         let asleep = world.bodies().filter(|(_, b)| b.is_asleep()).count();

@@ -8,7 +8,8 @@ use proptest::prelude::*;
 mod random_throws;
 
 const H: f64 = 1.0 / 60.0;
-const SOLVERS: [ContactSolver; 3] = [
+const SOLVERS: [ContactSolver; 4] = [
+    ContactSolver::Auto,
     ContactSolver::Exact,
     ContactSolver::Thesis,
     ContactSolver::Soft,

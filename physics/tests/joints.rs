@@ -1,9 +1,20 @@
-//! Pin joints: pendulum periods, hanging chains, broken joints, motors.
+//! Pin joints under the exact solver: pendulum periods, hanging chains, broken joints,
+//! motors.
 
-use pe::{BodyDef, BodyHandle, BodyMotor, ConvexPolygon, JointDef, JointMotor, Vec2, World};
+use pe::{
+    BodyDef, BodyHandle, BodyMotor, ContactSolver, ConvexPolygon, JointDef, JointMotor, Vec2, World,
+};
 use std::f64::consts::PI;
 
 const G: f64 = 9.81;
+
+/// A world under the exact solver, whose joints these tests measure (the default, `auto`,
+/// gives a jointed island too big to pivot to the soft step).
+fn exact_world(gravity: Vec2) -> World {
+    let mut world = World::new(gravity);
+    world.settings.contact_solver = ContactSolver::Exact;
+    world
+}
 
 /// Complete elliptic integral of the first kind by the arithmetic–geometric mean.
 fn elliptic_k(k: f64) -> f64 {
@@ -18,7 +29,7 @@ fn elliptic_k(k: f64) -> f64 {
 /// at `theta0` from the vertical. Returns the world, the bob, and the exact period of this
 /// compound pendulum: T = 4 √(I_p / (m g l)) K(sin(θ0/2)).
 fn pendulum(theta0: f64, l: f64, s: f64) -> (World, BodyHandle, f64) {
-    let mut world = World::new(Vec2::new(0.0, G));
+    let mut world = exact_world(Vec2::new(0.0, G));
     world.settings.length_scale = l;
     let pivot = Vec2::new(0.0, 0.0);
     let centre = pivot + Vec2::new(l * theta0.sin(), l * theta0.cos());
@@ -88,7 +99,7 @@ fn pendulum_periods_match_the_exact_compound_pendulum() {
 /// A chain of `n` links of length `len` hanging from the world at the origin, lying along
 /// +x at the start (so it swings), with the last link `end_mass_ratio` times heavier.
 fn chain(n: usize, len: f64, end_mass_ratio: f64) -> (World, Vec<pe::JointHandle>) {
-    let mut world = World::new(Vec2::new(0.0, G));
+    let mut world = exact_world(Vec2::new(0.0, G));
     world.settings.length_scale = len;
     let link = ConvexPolygon::rectangle(len, 0.1 * len).unwrap();
     let mut prev: Option<BodyHandle> = None;
@@ -143,7 +154,7 @@ fn ball_and_chain_holds_a_body_670_times_heavier_than_a_link() {
     // Solver2D's ball and chain: 40 links of 1 × 0.25 hanging from the world, released
     // horizontally, ending in a 16-gon of radius 7.4 (area 167, 670 links' mass). Iterative
     // solvers stretch such a chain visibly; a direct solve per island must not.
-    let mut world = World::new(Vec2::new(0.0, G));
+    let mut world = exact_world(Vec2::new(0.0, G));
     world.settings.length_scale = 1.0;
     let link = ConvexPolygon::rectangle(1.0, 0.25).unwrap();
     let ball = ConvexPolygon::regular(16, 7.4).unwrap();
@@ -238,7 +249,7 @@ fn broken_joint_closes_within_60_steps() {
 
 #[test]
 fn body_motor_reaches_and_holds_its_target() {
-    let mut world = World::new(Vec2::zeros());
+    let mut world = exact_world(Vec2::zeros());
     let shape = ConvexPolygon::rectangle(40.0, 20.0).unwrap();
     let body = world.add_body(BodyDef::new(shape, 1.0)).unwrap();
     let inertia = world.body(body).unwrap().inertia();
@@ -284,7 +295,7 @@ fn body_motor_reaches_and_holds_its_target() {
 
 #[test]
 fn joint_motor_drives_relative_speed_and_conserves_angular_momentum() {
-    let mut world = World::new(Vec2::zeros());
+    let mut world = exact_world(Vec2::zeros());
     let a = world
         .add_body(BodyDef::new(
             ConvexPolygon::rectangle(2.0, 0.5).unwrap(),
@@ -371,7 +382,7 @@ fn a_joint_motor_reports_the_impulse_of_the_whole_step() {
 /// (its `collide_connected`) and `remove_joint`, read at the next step.
 #[test]
 fn pinned_bodies_collide_exactly_when_their_joint_lets_them() {
-    let mut world = World::new(Vec2::new(0.0, 0.0));
+    let mut world = exact_world(Vec2::new(0.0, 0.0));
     let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
     let overlapping = [Vec2::new(0.0, 0.0), Vec2::new(0.5, 0.0)];
     let [a, b] = overlapping.map(|at| {

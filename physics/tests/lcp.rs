@@ -2,7 +2,7 @@
 //! ones, tiny and huge diagonals, and a brute-force enumeration of active sets for n ≤ 8.
 
 use nalgebra::{DMatrix, DVector};
-use pe::solver::lcp::{LcpMethod, LcpProblem, LcpSolver};
+use pe::solver::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -26,6 +26,7 @@ impl Owned {
             lo: &self.lo,
             hi: &self.hi,
             friction_index: None,
+            regularisation: REGULARISATION,
         }
     }
 

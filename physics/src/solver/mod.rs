@@ -59,11 +59,11 @@ pub enum ContactSolver {
     Soft,
     /// One boxed LCP per island with normals, friction bounded by the normal it solves
     /// for, pins and joint motors; penetration removed by a split-impulse position pass.
-    #[default]
     Exact,
-    /// Per island: `Exact` for islands of up to `StepSettings::dense_row_limit` LCP rows
-    /// (robots, small piles), where it pivots, and `Soft` for bigger ones, where it would
-    /// fall back to Gauss–Seidel sweeps (see `World::step`).
+    /// Per island: `Exact` where exact pivoting is needed and fast (robots, and small
+    /// islands of unlike masses), `Soft` for the rest (piles of like bodies), so that no
+    /// scene pays for pivoting it does not need. The default.
+    #[default]
     Auto,
 }
 

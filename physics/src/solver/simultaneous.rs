@@ -6,7 +6,7 @@ use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
 use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
-use super::lcp::{FrictionBound, LcpProblem, LcpSolver, LcpStats};
+use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
@@ -14,6 +14,12 @@ use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 /// (README, Physics): where the pivoting solve starts costing more than the whole rest of
 /// a step.
 pub const DENSE_ROW_LIMIT: usize = 96;
+
+/// The position pass's regularisation (`lcp::LcpProblem`): it moves bodies apart, where
+/// a compliance of 1e-9 changes nothing visible, and stacked boxes pressed into each other
+/// give it redundant rows on which pivoting at 1e-12 cycled to its cap (the overlapping
+/// pyramid: 20 solves over budget in 300 steps, against 1).
+const POSITION_REGULARISATION: f64 = 1e-9;
 
 /// How an island's constraints were solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,6 +50,10 @@ pub struct IslandReport {
     pub method: IslandMethod,
     /// Pivots made, or Gauss–Seidel sweeps (0 for the soft step's islands).
     pub pivots: usize,
+    /// Whether the exact solve stopped at its pivot budget (`lcp::LcpStats::over_budget`):
+    /// its last round stands, and under `auto` the island goes to the soft step for a
+    /// while.
+    pub over_budget: bool,
     /// The LCP's complementarity residual (NaN for Gauss–Seidel row by row, which never
     /// forms the matrix the residual is measured against).
     pub residual: f64,
@@ -94,6 +104,10 @@ pub struct SimultaneousSolver {
     x: Vec<f64>,
     lcp: LcpSolver,
     pub reports: Vec<IslandReport>,
+    /// The bodies of the islands that went over the pivot budget in the last solve.
+    pub over_budget_bodies: Vec<u32>,
+    /// The LCP's regularisation for the rows being solved (`lcp::LcpProblem`).
+    regularisation: f64,
     /// `StepSettings::dense_row_limit`, copied in before each solve.
     pub dense_row_limit: usize,
 }
@@ -111,6 +125,8 @@ impl SimultaneousSolver {
         targets: &VelocityTargets,
     ) {
         self.reports.clear();
+        self.over_budget_bodies.clear();
+        self.regularisation = REGULARISATION;
         self.memory.recall(contacts, &mut self.recalled);
         self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
         for island in 0..self.ranges.len() {
@@ -172,6 +188,7 @@ impl SimultaneousSolver {
             friction: false,
             close_joint_gaps: false,
         };
+        self.regularisation = POSITION_REGULARISATION;
         for island in 0..self.ranges.len() {
             self.load_island(island, &contacts_copy, &joints_copy);
             if self.island_contacts.iter().all(|(_, c)| c.depth <= slop) {
@@ -193,6 +210,7 @@ impl SimultaneousSolver {
                 }
             }
             self.solve_rows(&mut pseudo, true);
+            self.limit_separation(&mut pseudo, dt, slop);
         }
         for (body, p) in bodies.iter_mut().zip(&pseudo) {
             body.position += p.velocity * dt;
@@ -201,6 +219,34 @@ impl SimultaneousSolver {
         self.pseudo = pseudo;
         self.scratch_contacts = contacts_copy;
         self.scratch_joints = joints_copy;
+    }
+
+    /// Scales the island's pseudo-velocities down so that no contact point moves more
+    /// than twice the deepest excess penetration: a push the pins forbid (two pinned
+    /// bodies that overlap and may collide) has no solution, and the solve's answer to
+    /// it threw such a pair 164 m in one step.
+    fn limit_separation(&self, pseudo: &mut [SolverBody], dt: f64, slop: f64) {
+        let deepest = self
+            .island_contacts
+            .iter()
+            .map(|(_, c)| c.depth - slop)
+            .fold(0.0, f64::max);
+        let allowed = 2.0 * deepest;
+        let moved = self
+            .island_contacts
+            .iter()
+            .flat_map(|(_, c)| [c.body_a, c.body_b].map(|b| (b, c.point)))
+            .map(|(b, point)| pseudo[b as usize].velocity_at(point).norm() * dt)
+            .fold(0.0, f64::max);
+        if moved <= allowed {
+            return;
+        }
+        let scale = allowed / moved;
+        for end in self.rows.iter().flat_map(|r| r.ends.iter()) {
+            let body = &mut pseudo[end.body as usize];
+            body.velocity *= scale;
+            body.angular_velocity *= scale;
+        }
     }
 
     /// Groups contacts (and, if `with_joints`, joints) into islands: `ranges` of `grouped`.
@@ -317,12 +363,17 @@ impl SimultaneousSolver {
     fn solve_rows(&mut self, bodies: &mut [SolverBody], apply: bool) {
         let n = self.rows.len();
         let pivoting = n <= self.dense_row_limit;
-        let (pivots, residual) = if pivoting {
+        let (pivots, residual, over_budget, fell_back) = if pivoting {
             let stats = self.solve_rows_dense(bodies);
-            (stats.pivots, stats.residual)
+            let fell_back = stats.method == LcpMethod::ProjectedGaussSeidel;
+            (stats.pivots, stats.residual, stats.over_budget, fell_back)
         } else {
-            (self.solve_rows_sparse(bodies), f64::NAN)
+            (self.solve_rows_sparse(bodies), f64::NAN, false, false)
         };
+        if over_budget {
+            let ends = self.rows.iter().flat_map(|r| r.ends.iter().map(|e| e.body));
+            self.over_budget_bodies.extend(ends);
+        }
         if apply {
             for (row, &x) in self.rows.iter().zip(&self.x) {
                 row.apply(bodies, x);
@@ -331,12 +382,13 @@ impl SimultaneousSolver {
                 contacts: self.island_contacts.len(),
                 joints: self.island_joints.len(),
                 rows: n,
-                method: if pivoting {
+                method: if pivoting && !fell_back {
                     IslandMethod::Pivoting
                 } else {
                     IslandMethod::GaussSeidel
                 },
                 pivots,
+                over_budget,
                 residual,
             });
         }
@@ -362,6 +414,7 @@ impl SimultaneousSolver {
             lo: &self.lo,
             hi: &self.hi,
             friction_index: Some(&self.friction_index),
+            regularisation: self.regularisation,
         };
         self.lcp.solve_guessing(&problem, &self.guess, &mut self.x)
     }

@@ -12,7 +12,7 @@ use super::contact::{Contact, ContactMemory};
 use super::envelope::EnvelopeCholesky;
 use super::island::IslandGrouping;
 use super::joint::JointConstraint;
-use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver};
+use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use super::simultaneous::{IslandMethod, IslandReport};
 use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
 use crate::stage_clock::{self, Stage};
@@ -1169,6 +1169,7 @@ impl SoftStepSolver {
                     IslandMethod::SoftPinByPin
                 },
                 pivots: 0,
+                over_budget: false,
                 residual: f64::NAN,
             });
         }
@@ -1184,6 +1185,7 @@ impl SoftStepSolver {
                     IslandMethod::SoftPointByPoint
                 },
                 pivots: 0,
+                over_budget: false,
                 residual: f64::NAN,
             });
         }
@@ -2208,6 +2210,7 @@ impl ContactLcp {
                 lo: &self.lo,
                 hi: &self.hi,
                 friction_index: with_friction.then_some(&self.friction_index[..]),
+                regularisation: REGULARISATION,
             };
             // The starting impulses are in `b` already; the solve overwrites `x`.
             let solver = &mut self.solvers[index];
