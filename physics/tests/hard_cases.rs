@@ -827,3 +827,34 @@ fn numbers_that_would_poison_the_state_are_refused() {
     assert_eq!(before, after);
     assert_eq!(w.step_count(), 0);
 }
+
+/// Bodies dropped onto one spot: 600 unit boxes placed at one point overlap every other,
+/// 180,000 pairs. Each collides with at most 32 moving bodies at a time (the rest pass
+/// through it until they part), so contacts grow with the bodies, not their pairs: at
+/// most 32 × 600 / 2 moving pairs and the 600 on the floor. The pile spreads out without
+/// a non-finite number, under every solver.
+#[test]
+fn a_pile_up_at_one_point_keeps_a_bounded_number_of_pairs() {
+    for solver in SOLVERS {
+        let mut w = World::new(Vec2::new(0.0, 10.0));
+        w.settings.contact_solver = solver;
+        let floor = ConvexPolygon::rectangle(200.0, 1.0).unwrap();
+        w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for _ in 0..600 {
+            w.add_body(BodyDef::new(unit.clone(), 1.0).at(Vec2::new(0.0, -0.5), 0.0))
+                .unwrap();
+        }
+        for step in 0..3 {
+            w.step(H);
+            let pairs = w.manifolds().len();
+            assert!(
+                pairs <= 32 * 600 / 2 + 600,
+                "{solver:?}, step {step}: {pairs} pairs"
+            );
+            assert!(pairs > 600, "{solver:?}, step {step}: only {pairs} pairs");
+        }
+        assert!(finite(&w), "{solver:?}");
+    }
+}
