@@ -1,7 +1,7 @@
 //! The `robosim` command line: the editor by default, `run` and `check` headless.
 //! Every failure is one line on stderr and exit code 2.
 
-use crate::db::{Database, Problem};
+use crate::db::{Database, Problem, one_line};
 use crate::sim::Simulation;
 use crate::sim::trace::Record;
 use clap::{Parser, Subcommand, ValueEnum};
@@ -54,7 +54,7 @@ pub struct RunArgs {
     #[arg(long, default_value_t = 1000)]
     pub steps: u64,
     /// The step in seconds (default: the scene's `timestep`, else 0.05).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_step)]
     pub dt: Option<f64>,
     /// The contact solver: auto, exact, soft, thesis or sequential (default: the scene's,
     /// else auto).
@@ -75,6 +75,18 @@ pub struct RunArgs {
     pub out: Option<PathBuf>,
 }
 
+/// A step in seconds: a finite number > 0 (its range is the scene's to check).
+fn parse_step(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(dt) if dt.is_finite() && dt > 0.0 => Ok(dt),
+        Ok(dt) => Err(format!(
+            "{} is not a step: a number of seconds > 0",
+            crate::db::write::number(dt)
+        )),
+        Err(_) => Err(format!("\"{}\" is not a number", crate::db::clip(text))),
+    }
+}
+
 fn parse_solver(name: &str) -> Result<ContactSolver, String> {
     ContactSolver::from_name(name).ok_or_else(|| {
         let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
@@ -89,6 +101,107 @@ pub const NO_EDITOR: &str =
 /// A failure to report: one line, exit code 2.
 pub struct Failure(pub String);
 
+/// Standard output, where a report or a trace goes. A write that fails ends the command
+/// with one line and exit code 2 (a full disk, a closed descriptor); a reader that went
+/// away (`robosim check | head -1`) ends it quietly, with exit code 0.
+enum Written {
+    Failed(Failure),
+    ReaderGone,
+}
+
+impl Written {
+    fn of(error: std::io::Error, what: &str) -> Self {
+        if error.kind() == std::io::ErrorKind::BrokenPipe {
+            Written::ReaderGone
+        } else {
+            Written::Failed(Failure(format!("cannot write {what}: {error}")))
+        }
+    }
+
+    /// The command's outcome once output could not be written.
+    fn outcome(self) -> Result<ExitCode, Failure> {
+        match self {
+            Written::Failed(failure) => Err(failure),
+            Written::ReaderGone => Ok(ExitCode::SUCCESS),
+        }
+    }
+}
+
+/// Standard output as a file. Rust's own `stdout()` reports a closed descriptor
+/// (`robosim run ... >&-`) as written, and the trace would vanish with exit code 0; a
+/// file on descriptor 1 reports it.
+fn standard_output() -> Box<dyn Write> {
+    #[cfg(unix)]
+    {
+        use std::os::fd::FromRawFd;
+        /// Descriptor 1, borrowed: written to, never closed.
+        struct Descriptor1(std::mem::ManuallyDrop<std::fs::File>);
+        impl Write for Descriptor1 {
+            fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+                self.0.write(bytes)
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                self.0.flush()
+            }
+        }
+        // SAFETY: descriptor 1 is the process's standard output, ours to write; it is
+        // wrapped so that dropping the file does not close it.
+        let file = unsafe { std::fs::File::from_raw_fd(1) };
+        Box::new(Descriptor1(std::mem::ManuallyDrop::new(file)))
+    }
+    #[cfg(not(unix))]
+    {
+        Box::new(std::io::stdout())
+    }
+}
+
+/// Whether standard output was closed when the process started (`>&-`). Rust's runtime
+/// then opens /dev/null on descriptor 1, read-write, so that writes vanish without an
+/// error; a shell's `> /dev/null` opens it write-only. That read-write /dev/null is the
+/// sign.
+fn standard_output_was_closed() -> bool {
+    #[cfg(unix)]
+    {
+        // SAFETY: plain queries of descriptor 1 into a zeroed stat buffer.
+        unsafe {
+            let flags = libc::fcntl(1, libc::F_GETFL);
+            let mut stat: libc::stat = std::mem::zeroed();
+            if flags == -1 || libc::fstat(1, &mut stat) != 0 {
+                return true;
+            }
+            let read_write = flags & libc::O_ACCMODE == libc::O_RDWR;
+            let dev_null = std::fs::metadata("/dev/null").is_ok_and(|m| {
+                use std::os::unix::fs::MetadataExt;
+                m.rdev() == stat.st_rdev as u64
+            });
+            let char_device = stat.st_mode & libc::S_IFMT == libc::S_IFCHR;
+            read_write && char_device && dev_null
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        false
+    }
+}
+
+/// clap's message for bad arguments as one line: what is wrong and the arguments it names
+/// (its usage lines and hints left out).
+fn argument_error(rendered: &str) -> String {
+    let lines: Vec<&str> = rendered
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty() && !l.starts_with("tip:"))
+        .collect();
+    let line = lines.join(" ");
+    let line = line.trim_start_matches("error: ").to_string();
+    if line.is_empty() {
+        "bad arguments".to_string()
+    } else {
+        line
+    }
+}
+
 /// Runs the CLI with `args`; `open_editor` is called when no subcommand is given.
 pub fn main(
     args: impl IntoIterator<Item = std::ffi::OsString>,
@@ -102,13 +215,8 @@ pub fn main(
             return ExitCode::SUCCESS;
         }
         Err(e) => {
-            let text = e.render().to_string();
-            let line = text
-                .lines()
-                .next()
-                .unwrap_or("bad arguments")
-                .trim_start_matches("error: ");
-            eprintln!("robosim: {line}");
+            let line = argument_error(&e.render().to_string());
+            let _ = writeln!(std::io::stderr(), "robosim: {}", one_line(line));
             return ExitCode::from(2);
         }
     };
@@ -122,7 +230,8 @@ pub fn main(
     match result {
         Ok(code) => code,
         Err(Failure(message)) => {
-            eprintln!("robosim: {message}");
+            // Nowhere left to say it if standard error is gone too: the exit code says it.
+            let _ = writeln!(std::io::stderr(), "robosim: {}", one_line(message));
             ExitCode::from(2)
         }
     }
@@ -140,19 +249,32 @@ fn require_dir(db: &Path) -> Result<(), Failure> {
 pub fn check(db: &Path) -> Result<ExitCode, Failure> {
     require_dir(db)?;
     let (database, problems) = Database::load(db);
-    for p in &problems {
-        println!("{p}");
-    }
     let errors = problems.iter().filter(|p| p.is_error()).count();
     let warnings = problems.len() - errors;
     let m = &database.model;
-    println!(
-        "{}: {} bodies, {} robots, {} scenes; {errors} errors, {warnings} warnings",
-        db.display(),
-        m.bodies.len(),
-        m.robots.len(),
-        m.scenes.len()
-    );
+    if standard_output_was_closed() {
+        return Err(Failure(
+            "standard output is closed: nowhere to write the report".into(),
+        ));
+    }
+    let mut out = std::io::BufWriter::new(standard_output());
+    let report = (|| {
+        for p in &problems {
+            writeln!(out, "{p}")?;
+        }
+        writeln!(
+            out,
+            "{}: {} bodies, {} robots, {} scenes; {errors} errors, {warnings} warnings",
+            db.display(),
+            m.bodies.len(),
+            m.robots.len(),
+            m.scenes.len()
+        )?;
+        out.flush()
+    })();
+    if let Err(e) = report {
+        return Written::of(e, "the report to standard output").outcome();
+    }
     Ok(if errors > 0 {
         ExitCode::from(1)
     } else {
@@ -173,12 +295,8 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         };
         return Err(Failure(format!("{first}{more}")));
     }
-    if let Some(dt) = args.dt
-        && !dt.is_finite()
-    {
-        return Err(Failure(format!(
-            "--dt {dt} is not a finite number of seconds"
-        )));
+    if let Some(out) = &args.out {
+        refuse_to_overwrite_the_database(out, &args.db)?;
     }
     let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
         .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
@@ -192,7 +310,16 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             std::fs::File::create(path)
                 .map_err(|e| Failure(format!("{}: cannot write: {e}", path.display())))?,
         ),
-        None => Box::new(std::io::stdout().lock()),
+        None if standard_output_was_closed() => {
+            return Err(Failure(
+                "standard output is closed: nowhere to write the trace (use --out FILE)".into(),
+            ));
+        }
+        None => standard_output(),
+    };
+    let destination = match &args.out {
+        Some(path) => path.display().to_string(),
+        None => "the trace to standard output".to_string(),
     };
     let mut out = std::io::BufWriter::new(sink);
     let progress = if args.steps >= 5_000 {
@@ -200,45 +327,64 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let write_error = |e: &dyn std::fmt::Display| Failure(format!("writing the trace: {e}"));
+    let written = |e: std::io::Error| Written::of(e, &destination);
     let mut header_written = false;
-    let mut emit = |sim: &Simulation, out: &mut dyn Write| -> Result<(), Failure> {
+    let mut emit = |sim: &Simulation, out: &mut dyn Write| -> Result<(), std::io::Error> {
         let record = Record::of(sim);
         match format {
-            Format::Jsonl => {
-                writeln!(out, "{}", record.to_json_line()).map_err(|e| write_error(&e))
-            }
+            Format::Jsonl => writeln!(out, "{}", record.to_json_line()),
             Format::Csv => {
                 let mut w = csv::WriterBuilder::new()
                     .has_headers(false)
                     .from_writer(out);
                 if !header_written {
-                    w.write_record(record.csv_header())
-                        .map_err(|e| write_error(&e))?;
+                    w.write_record(record.csv_header())?;
                     header_written = true;
                 }
-                w.write_record(record.csv_row())
-                    .map_err(|e| write_error(&e))?;
-                w.flush().map_err(|e| write_error(&e))
+                w.write_record(record.csv_row())?;
+                w.flush()
             }
         }
     };
-    emit(&sim, &mut out)?;
+    if let Err(e) = emit(&sim, &mut out) {
+        return written(e).outcome();
+    }
     for _ in 0..args.steps {
-        sim.step();
+        let stepped = sim.try_step();
         let step = sim.step_count();
-        if sim.has_non_finite_state() {
+        if let Err(reason) = stepped {
+            let _ = out.flush();
             return Err(Failure(format!(
-                "scene \"{}\": the state became non-finite at step {step}",
-                args.scene
+                "scene \"{}\": step {step}: {reason}",
+                crate::db::clip(&args.scene)
             )));
         }
-        if step % args.every == 0 || step == args.steps {
-            emit(&sim, &mut out)?;
+        if (step % args.every == 0 || step == args.steps)
+            && let Err(e) = emit(&sim, &mut out)
+        {
+            return written(e).outcome();
         }
         progress.inc(1);
     }
     progress.finish_and_clear();
-    out.flush().map_err(|e| write_error(&e))?;
+    if let Err(e) = out.flush() {
+        return written(e).outcome();
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses a trace file that is one of the database's own files (or the folder).
+fn refuse_to_overwrite_the_database(out: &Path, db: &Path) -> Result<(), Failure> {
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    let files = crate::db::FileKind::ALL.map(|k| db.join(k.file_name()));
+    if same(out, db) || files.iter().any(|f| same(out, f)) {
+        return Err(Failure(format!(
+            "{}: --out would overwrite the database being run; choose another file",
+            out.display()
+        )));
+    }
+    Ok(())
 }

@@ -29,6 +29,10 @@ pub enum BodyError {
     /// A number beyond its limit in `crate::limits`: what, value, limit.
     #[error("{0} {1:e} is beyond ±{2:e}")]
     Beyond(&'static str, f64, f64),
+    /// A positive density too small for its mass or moment of inertia to have an inverse
+    /// (below the smallest normal float, whose inverse overflows).
+    #[error("density {0:e} gives a mass of {1:e}, too small to simulate (its inverse overflows)")]
+    TooLight(f64, f64),
 }
 
 /// Everything needed to make a body: shape, material and where it starts.
@@ -170,6 +174,9 @@ impl Body {
             })
             .fold(f64::INFINITY, f64::min);
         let (mass, inertia) = (def.density * mp.area, def.density * mp.second_moment);
+        if def.density > 0.0 && !(mass.is_normal() && inertia.is_normal()) {
+            return Err(BodyError::TooLight(def.density, mass.min(inertia)));
+        }
         let inverse = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
         Ok(Self {
             local_vertices,

@@ -33,4 +33,4 @@ pub use solver::ContactSolver;
 pub use solver::contact::Contact;
 pub use solver::joint::{Joint, JointHandle, JointMotor};
 pub use solver::motor::{BodyMotor, MotorError};
-pub use world::{Integrator, JointDef, JointError, StepError, StepSettings, World};
+pub use world::{FALL_PER_STEP, Integrator, JointDef, JointError, StepError, StepSettings, World};

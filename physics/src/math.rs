@@ -63,6 +63,28 @@ impl Rot {
     }
 }
 
+/// `x` held within `[lo, hi]`: the upper bound where `hi < x`, then the lower where
+/// `lo >` that. Bit for bit `f64::clamp` (a zero keeps its sign) for `lo <= hi`, and
+/// as the soft step's lanes clamp; unlike `f64::clamp` it never panics: a NaN bound (a
+/// state gone non-finite, which the step reports) is passed over.
+#[inline(always)]
+pub fn clamp(x: f64, lo: f64, hi: f64) -> f64 {
+    let below_hi = if hi < x { hi } else { x };
+    if lo > below_hi { lo } else { below_hi }
+}
+
+/// `a` where `a > b`, else `b`: the soft step's lanes' `max`, to the bit.
+#[inline(always)]
+pub fn greater(a: f64, b: f64) -> f64 {
+    if a > b { a } else { b }
+}
+
+/// `a` where `a < b`, else `b`: the soft step's lanes' `min`, to the bit.
+#[inline(always)]
+pub fn lesser(a: f64, b: f64) -> f64 {
+    if a < b { a } else { b }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

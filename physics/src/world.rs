@@ -167,7 +167,27 @@ pub enum StepError {
     BadGravity(f64, f64),
     #[error("the world's friction must be a number in [0, 1e6], got {0}")]
     BadFriction(f64),
+    #[error(
+        "gravity carries a body {fall:e} from rest in one step, more than {limit:e} ({FALL_PER_STEP} length scales): bodies would fall through each other; take a smaller step"
+    )]
+    FallsTooFar { fall: f64, limit: f64 },
+    /// The step ended with a body's state non-finite or beyond `crate::limits` (an
+    /// absurd force, a collapse no solver can hold): the world's state is not to be
+    /// trusted, and further steps are pointless.
+    #[error("body {body} left the limits: its {what} is {value:.3e} (at most ±{limit:e})")]
+    StateBeyond {
+        body: u32,
+        what: &'static str,
+        value: f64,
+        limit: f64,
+    },
 }
+
+/// The farthest gravity may carry a body from rest in one step (g·h²), in length scales:
+/// beyond it bodies fall through each other between two contact searches (the sequential
+/// solver let a box through a floor twice its size from 37 length scales a step; every
+/// other solver holds at any gravity within `limits::GRAVITY`).
+pub const FALL_PER_STEP: f64 = 10.0;
 
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
 /// at once overshoots in stacks, where pushes add up along the column.
@@ -682,15 +702,18 @@ impl World {
     /// bodies already; this catches what they miss (a spinning body, the soft step's
     /// contacts found only at the step's start, a link the thesis's joint pass drags on).
     ///
-    /// A step that would put a non-finite number into the state (see `try_step`) does
-    /// nothing.
+    /// A step refused by `try_step` does nothing; one that leaves a body's state beyond
+    /// the limits is reported there, and here ignored.
     pub fn step(&mut self, dt: f64) {
         let _refused = self.try_step(dt);
     }
 
     /// `step`, refusing a time step that is not finite and positive, gravity or a world
-    /// friction (≥ 0) that is not finite or beyond its limit in `crate::limits`, with the
-    /// reason. (Bodies, joints and motors are checked when they are added.)
+    /// friction (≥ 0) that is not finite or beyond its limit in `crate::limits`, or gravity
+    /// that would carry a body more than `FALL_PER_STEP` length scales in the step, with
+    /// the reason; and reporting a step that left a moving body's state non-finite or
+    /// beyond the limits (then the state is not to be trusted). (Bodies, joints and motors
+    /// are checked when they are added.)
     pub fn try_step(&mut self, dt: f64) -> Result<(), StepError> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepError::BadTimeStep(dt));
@@ -702,9 +725,39 @@ impl World {
         if !(0.0..=crate::limits::FRICTION).contains(&self.friction) {
             return Err(StepError::BadFriction(self.friction));
         }
+        let fall = self.gravity.norm() * dt * dt;
+        let limit = FALL_PER_STEP * self.settings.length_scale;
+        if fall > limit {
+            return Err(StepError::FallsTooFar { fall, limit });
+        }
         let started = stage_clock::mark();
         self.advance(dt);
         stage_clock::record(Stage::Step, started);
+        self.check_state()
+    }
+
+    /// Every moving body's state finite and within `crate::limits`.
+    fn check_state(&self) -> Result<(), StepError> {
+        use crate::limits::{COORDINATE, SPEED, SPIN};
+        for (i, body) in self.bodies.iter().enumerate() {
+            let Some(b) = body.as_ref().filter(|b| !b.is_fixed()) else {
+                continue;
+            };
+            let numbers = [
+                ("x", b.position.x, COORDINATE),
+                ("y", b.position.y, COORDINATE),
+                ("speed", b.velocity.norm(), SPEED),
+                ("spin", b.angular_velocity, SPIN),
+            ];
+            if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
+                return Err(StepError::StateBeyond {
+                    body: i as u32,
+                    what,
+                    value,
+                    limit,
+                });
+            }
+        }
         Ok(())
     }
 

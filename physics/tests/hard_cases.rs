@@ -858,3 +858,98 @@ fn a_pile_up_at_one_point_keeps_a_bounded_number_of_pairs() {
         assert!(finite(&w), "{solver:?}");
     }
 }
+
+/// A 20 × 20 box on a floor twice as thick, under gravity up to `limits::GRAVITY` and at
+/// the largest step the fall limit allows for it (`FALL_PER_STEP` length scales a step,
+/// the box's bounding radius the length scale): no solver lets it through the floor. (The
+/// soft step's springs let a box through at g = 1e5 and h = 1 until a touching point was
+/// held at a tenth of a length scale deep a substep; the sequential solver, from 37 length
+/// scales a step.)
+#[test]
+fn every_solver_holds_a_box_on_the_floor_at_the_limits() {
+    for solver in ContactSolver::ALL {
+        for g in [1e3, 1e5, 1e7, pe::limits::GRAVITY] {
+            let length_scale = 200f64.sqrt();
+            let h = (pe::FALL_PER_STEP * length_scale / g).sqrt();
+            let mut w = World::new(Vec2::new(0.0, g));
+            w.settings.contact_solver = solver;
+            w.settings.length_scale = length_scale;
+            let floor = ConvexPolygon::rectangle(400.0, 40.0).unwrap();
+            w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 20.0), 0.0))
+                .unwrap();
+            let square = ConvexPolygon::rectangle(20.0, 20.0).unwrap();
+            let b = w
+                .add_body(BodyDef::new(square, 1.0).at(Vec2::new(0.0, -10.0), 0.0))
+                .unwrap();
+            for step in 0..100 {
+                w.try_step(h).unwrap();
+                let y = w.body(b).unwrap().position.y;
+                // Resting on the floor's top at y = 0, within a tenth of its size.
+                assert!(
+                    (-12.0..=-8.0).contains(&y),
+                    "{solver:?} g {g:e} h {h:e}: y {y} at step {step}"
+                );
+            }
+        }
+        // One step more than the limit is refused, before anything moves.
+        let mut w = World::new(Vec2::new(0.0, 1e7));
+        w.settings.contact_solver = solver;
+        assert!(matches!(
+            w.try_step(1.0),
+            Err(pe::StepError::FallsTooFar { .. })
+        ));
+    }
+}
+
+/// A box of density 1e-30 (a feather in any units) resting on the floor moves exactly as
+/// one of density 1 does: nothing in a solve depends on the scale of the masses (the exact
+/// solver's checks once had absolute tolerances, and at 1e-20 the box slid at 0.6 px/s,
+/// at 1e-30 it fell through the floor). Under every solver but the naive sequential one
+/// (which rocks a box on its corners, SPEC §2.4.5) it lies still. A density whose mass
+/// underflows is refused.
+#[test]
+fn a_very_light_body_moves_as_a_heavy_one() {
+    let rest = |solver: ContactSolver, density: f64| {
+        let mut w = World::new(Vec2::new(0.0, 9.1));
+        w.settings.contact_solver = solver;
+        w.settings.length_scale = 14.0;
+        w.friction = 0.7;
+        let floor = ConvexPolygon::rectangle(400.0, 40.0).unwrap();
+        w.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 20.0), 0.0))
+            .unwrap();
+        let square = ConvexPolygon::rectangle(20.0, 20.0).unwrap();
+        let b = w
+            .add_body(BodyDef::new(square, density).at(Vec2::new(0.0, -10.0), 0.0))
+            .unwrap();
+        for _ in 0..200 {
+            w.try_step(0.05).unwrap();
+        }
+        let body = w.body(b).unwrap();
+        (body.position, body.velocity)
+    };
+    for solver in ContactSolver::ALL {
+        let (p1, v1) = rest(solver, 1.0);
+        for density in [1e-30, 1e-100, 1e-300] {
+            let (p, v) = rest(solver, density);
+            // The same solve in other units: equal but for rounding, which 200 steps carry
+            // to a few billionths of a pixel (a millionth bounds it).
+            assert!(
+                (p - p1).norm() < 1e-6 && (v - v1).norm() < 1e-6,
+                "{solver:?} {density:e}: at {p:?} moving {v:?}, against {p1:?} {v1:?}"
+            );
+        }
+        if solver != ContactSolver::Sequential {
+            // The soft step rests 0.001 px deep in the floor (its springs), the others on it.
+            let moved = (p1 - Vec2::new(0.0, -10.0)).norm();
+            assert!(
+                moved < 0.01 && v1.norm() < 1e-6,
+                "{solver:?}: {p1:?} {v1:?}"
+            );
+        }
+    }
+    let square = ConvexPolygon::rectangle(20.0, 20.0).unwrap();
+    assert!(matches!(
+        pe::Body::new(BodyDef::new(square, 1e-320)),
+        Err(pe::BodyError::TooLight(..))
+    ));
+}

@@ -118,8 +118,16 @@ fn check_body(body: &BodyDef, file: &str, out: &mut Vec<Problem>) {
     if let Some(mu) = body.friction.filter(|mu| *mu < 0.0) {
         error(format!("friction {mu} is negative"));
     }
-    if let Err(e) = polygon(body) {
-        error(format!("the vertices are not a usable convex polygon: {e}"));
+    match polygon(body) {
+        Err(e) => error(format!("the vertices are not a usable convex polygon: {e}")),
+        // What pe refuses to step, refused here in its words.
+        Ok(polygon) if body.density > 0.0 && body.density.is_finite() => {
+            let def = pe::BodyDef::new(polygon, body.density);
+            if let Err(e @ pe::BodyError::TooLight(..)) = pe::Body::new(def) {
+                error(e.to_string());
+            }
+        }
+        Ok(_) => {}
     }
     let vertices = body
         .vertices
@@ -352,6 +360,10 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             );
         }
     }
+    if let Some(message) = falls_too_far(model, scene) {
+        let what = format!("<scene> \"{}\"", clip(&scene.name));
+        out.push(Problem::error(file, &what, message).at(scene.location));
+    }
     let mut aliases: BTreeMap<&str, ()> = BTreeMap::new();
     for b in &scene.bodies {
         let what = format!(
@@ -383,6 +395,41 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             );
         }
     }
+}
+
+/// What pe would refuse at the scene's first step: gravity carrying a body more than
+/// `pe::FALL_PER_STEP` length scales in a step (the length scale as the simulation takes
+/// it: the median size of the scene's moving bodies).
+fn falls_too_far(model: &Model, scene: &Scene) -> Option<String> {
+    let robot_bodies = scene
+        .robots
+        .iter()
+        .filter_map(|r| model.robot(&r.source))
+        .flat_map(|r| r.bodies.iter().map(|b| &b.placement.source));
+    let sources = scene.bodies.iter().map(|b| &b.source).chain(robot_bodies);
+    let mut sizes: Vec<f64> = sources
+        .filter_map(|source| model.body(source))
+        .filter(|def| def.density > 0.0)
+        .filter_map(|def| {
+            let body = pe::Body::new(pe::BodyDef::new(polygon(def).ok()?, def.density)).ok()?;
+            Some(body.bounding_radius())
+        })
+        .collect();
+    sizes.sort_by(f64::total_cmp);
+    let length_scale = sizes.get(sizes.len() / 2).copied().unwrap_or(1.0);
+    let h = scene.timestep();
+    let fall = scene.gravitation.abs() * h * h;
+    let limit = pe::FALL_PER_STEP * length_scale;
+    (fall > limit).then(|| {
+        format!(
+            "gravitation {} at timestep {} s carries a body {fall:.3e} per step from rest, \
+             more than {} times the typical body's size ({length_scale:.3e}): bodies would \
+             fall through each other; take a smaller timestep",
+            super::write::number(scene.gravitation),
+            super::write::number(h),
+            pe::FALL_PER_STEP,
+        )
+    })
 }
 
 /// Where robot `robot`, placed in a scene by `placed`, puts its bodies and pins beyond the

@@ -9,7 +9,7 @@ pub mod write;
 mod xml;
 
 pub use check::{TIMESTEP_RANGE, beyond_all, check, limits, outline_polygon, polygon};
-pub use problem::{Problem, Severity};
+pub use problem::{Problem, Severity, one_line};
 pub use xml::{MAX_DEPTH, clip};
 
 use crate::model::{Model, same_name};
@@ -80,6 +80,13 @@ pub enum SaveError {
         path: PathBuf,
         source: std::io::Error,
     },
+    /// Every file is in place, but the folder could not be synced: a power cut now might
+    /// still undo the save.
+    #[error("saved, but {path} could not be synced to disk: {source}")]
+    NotDurable {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// Whether a save may replace files that changed on disk or lost records on load.
@@ -108,7 +115,7 @@ impl Database {
         let mut problems = Vec::new();
         for kind in FileKind::ALL {
             let path = dir.join(kind.file_name());
-            let bytes = match std::fs::read(&path) {
+            let bytes = match read_file(&path) {
                 Ok(bytes) => Some(bytes),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
                 Err(e) => {
@@ -155,10 +162,20 @@ impl Database {
             let loaded = &mut db.loaded[kind.index()];
             loaded.bytes = bytes;
             let Some(bytes) = &loaded.bytes else { continue };
-            let root = match xml::decode(bytes, &name).and_then(|text| xml::parse(text, &name)) {
-                Ok(root) => root,
-                Err(p) => {
-                    problems.push(p);
+            let parsed = match xml::decode(bytes, &name) {
+                Ok(decoded) => {
+                    problems.extend(decoded.warning);
+                    xml::parse(&decoded.text, &name)
+                }
+                Err(p) => Err(vec![p]),
+            };
+            let (root, syntax_skipped) = match parsed {
+                Ok(parsed) => {
+                    problems.extend(parsed.problems);
+                    (parsed.root, parsed.skipped)
+                }
+                Err(file_problems) => {
+                    problems.extend(file_problems);
                     loaded.lossy = true;
                     continue;
                 }
@@ -183,7 +200,7 @@ impl Database {
                     r.skipped
                 }
             };
-            db.loaded[kind.index()].lossy = skipped;
+            db.loaded[kind.index()].lossy = skipped || syntax_skipped;
         }
         db.clean = db.model.clone();
         db
@@ -226,7 +243,7 @@ impl Database {
             for kind in FileKind::ALL {
                 let path = dir.join(kind.file_name());
                 self.loaded[kind.index()] = Loaded {
-                    bytes: std::fs::read(path).ok(),
+                    bytes: read_file(&path).ok(),
                     lossy: false,
                 };
             }
@@ -236,13 +253,14 @@ impl Database {
         Ok(())
     }
 
-    /// [`Database::save`] with a hook run just before each rename (tests use it to
-    /// interrupt a save).
+    /// [`Database::save`] with a hook run before each step of the save (`SaveStep`); an
+    /// error from it fails that step, as a full disk or a power cut would (the tests
+    /// fail every step in turn).
     pub fn save_with(
         &mut self,
         dir: &Path,
         overwrite: Overwrite,
-        mut before_rename: impl FnMut(&Path) -> std::io::Result<()>,
+        mut before: impl FnMut(SaveStep) -> std::io::Result<()>,
     ) -> Result<(), SaveError> {
         let texts: Vec<(FileKind, String)> =
             FileKind::ALL.iter().map(|&k| (k, self.render(k))).collect();
@@ -250,7 +268,7 @@ impl Database {
         for (kind, text) in &texts {
             let path = dir.join(kind.file_name());
             let loaded = &self.loaded[kind.index()];
-            let on_disk = std::fs::read(&path).ok();
+            let on_disk = read_file(&path).ok();
             if on_disk.as_deref() == Some(text.as_bytes()) {
                 continue;
             }
@@ -267,26 +285,39 @@ impl Database {
             path: dir.to_path_buf(),
             source,
         })?;
+        let mut changed = Vec::new();
         for (kind, text) in texts {
             let path = dir.join(kind.file_name());
-            let unchanged = std::fs::read(&path).ok().as_deref() == Some(text.as_bytes());
+            let unchanged = read_file(&path).ok().as_deref() == Some(text.as_bytes());
             // A file that never existed and would be empty stays absent.
             let empty_new = !path.exists() && self.collection_is_empty(kind);
             if !unchanged && !empty_new {
-                write_atomic(&path, text.as_bytes(), &mut before_rename).map_err(|source| {
-                    SaveError::Io {
-                        path: path.clone(),
-                        source,
-                    }
-                })?;
+                changed.push((kind, path, text.into_bytes()));
             }
+        }
+        let files: Vec<(&Path, &[u8])> = changed
+            .iter()
+            .map(|(_, p, t)| (p.as_path(), t.as_slice()))
+            .collect();
+        let kinds: Vec<FileKind> = changed.iter().map(|(k, ..)| *k).collect();
+        let not_durable = match write_all_or_nothing(&files, &kinds, &mut before) {
+            Ok(()) => None,
+            Err((path, SaveFailure::Io(source))) => return Err(SaveError::Io { path, source }),
+            Err((path, SaveFailure::NotDurable(source))) => Some((path, source)),
+        };
+        // Every file is renamed into place: what is on disk is what was saved, even if the
+        // folder could not be synced (then say so, but do not refuse the next save).
+        for kind in FileKind::ALL {
             self.loaded[kind.index()] = Loaded {
-                bytes: std::fs::read(&path).ok(),
+                bytes: read_file(&dir.join(kind.file_name())).ok(),
                 lossy: false,
             };
         }
         self.clean = self.model.clone();
-        Ok(())
+        match not_durable {
+            Some((path, source)) => Err(SaveError::NotDurable { path, source }),
+            None => Ok(()),
+        }
     }
 
     fn collection_is_empty(&self, kind: FileKind) -> bool {
@@ -304,7 +335,7 @@ impl Database {
         };
         FileKind::ALL
             .into_iter()
-            .filter(|k| std::fs::read(dir.join(k.file_name())).ok() != self.loaded[k.index()].bytes)
+            .filter(|k| read_file(&dir.join(k.file_name())).ok() != self.loaded[k.index()].bytes)
             .collect()
     }
 
@@ -315,15 +346,166 @@ impl Database {
     }
 }
 
-/// Writes `bytes` to `path` so that a crash leaves either the old or the new file: a
-/// temporary file in the same directory, written, flushed and fsynced, then renamed over
-/// the old one (and the directory fsynced, so the rename itself is durable).
-pub fn write_atomic(
-    path: &Path,
-    bytes: &[u8],
-    before_rename: &mut impl FnMut(&Path) -> std::io::Result<()>,
-) -> std::io::Result<()> {
-    let dir = path
+/// The largest database file read: far beyond any database (the default's three files
+/// are 10 KB), far below what a read of `/dev/zero` would fill memory with.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// A database file's bytes: a regular file (a FIFO would wait for a writer for ever, a
+/// device read for ever) of at most `MAX_FILE_BYTES`.
+pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        // Opening a FIFO waits for a writer, unless asked not to.
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(std::io::Error::other(
+            "not a regular file (a folder, a FIFO or a device)",
+        ));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "{} bytes, more than a database file may hold ({} MiB)",
+            meta.len(),
+            MAX_FILE_BYTES >> 20
+        )));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "more than a database file may hold ({} MiB)",
+            MAX_FILE_BYTES >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
+/// One step of saving, for failure injection (`Database::save_with`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SaveStep {
+    /// Writing and syncing a file's new text to a temporary file beside it.
+    WriteTemporary(FileKind),
+    /// Keeping the old file as a backup (a hard link) before replacing it.
+    KeepBackup(FileKind),
+    /// Renaming the temporary file over the file.
+    Rename(FileKind),
+    /// Syncing the folder, so that the renames last.
+    SyncFolder,
+}
+
+/// Why writing the files failed: an error that left the old files in place, or one after
+/// every file was renamed into place (only the folder's sync failed).
+#[derive(Debug)]
+enum SaveFailure {
+    Io(std::io::Error),
+    NotDurable(std::io::Error),
+}
+
+/// Writes several files as one: either every one has its new text or every one keeps its
+/// old (a crash part way leaves old files and, at most, a backup or temporary file beside
+/// them). Every new text is written to a temporary file in its folder and synced first;
+/// then each old file is kept as a backup (a hard link, or a copy where the file system
+/// has none) and the temporary renamed over it; if a rename fails, the files already
+/// replaced get their backups back. A file keeps its permissions, and a symbolic link
+/// keeps pointing where it did: its target is what gets written.
+fn write_all_or_nothing(
+    files: &[(&Path, &[u8])],
+    kinds: &[FileKind],
+    before: &mut impl FnMut(SaveStep) -> std::io::Result<()>,
+) -> Result<(), (PathBuf, SaveFailure)> {
+    fn io(path: &Path) -> impl FnOnce(std::io::Error) -> (PathBuf, SaveFailure) + '_ {
+        move |e| (path.to_path_buf(), SaveFailure::Io(e))
+    }
+    // Where each file really is (through symbolic links), and its temporary beside it.
+    let mut staged = Vec::new();
+    for (&(path, bytes), &kind) in files.iter().zip(kinds) {
+        let target = resolve_links(path).map_err(io(path))?;
+        before(SaveStep::WriteTemporary(kind)).map_err(io(path))?;
+        let temp = write_temporary(&target, bytes).map_err(io(path))?;
+        staged.push((kind, path, target, temp));
+    }
+    // Old files are kept until every new one is in place.
+    let mut replaced: Vec<(PathBuf, Option<PathBuf>)> = Vec::new();
+    let mut failure = None;
+    for (kind, path, target, temp) in staged {
+        let step = (|| {
+            before(SaveStep::KeepBackup(kind))?;
+            let backup = keep_backup(&target)?;
+            replaced.push((target.clone(), backup));
+            before(SaveStep::Rename(kind))?;
+            temp.persist(&target).map_err(|e| e.error)?;
+            Ok::<(), std::io::Error>(())
+        })();
+        if let Err(e) = step {
+            failure = Some((path.to_path_buf(), e));
+            break;
+        }
+    }
+    if let Some((path, e)) = failure {
+        // The way back: every file already replaced gets its old text (or is removed if it
+        // is new); `replaced`'s last entry may not have been renamed yet, which restoring
+        // its backup leaves as it was.
+        for (target, backup) in replaced.iter().rev() {
+            match backup {
+                Some(backup) => {
+                    // Renaming a link over another link to the same file does nothing:
+                    // then the backup is removed.
+                    let _ = std::fs::rename(backup, target);
+                    let _ = std::fs::remove_file(backup);
+                }
+                None => {
+                    let _ = std::fs::remove_file(target);
+                }
+            }
+        }
+        return Err((path, SaveFailure::Io(e)));
+    }
+    for (_, backup) in &replaced {
+        if let Some(backup) = backup {
+            let _ = std::fs::remove_file(backup);
+        }
+    }
+    let mut folders: Vec<&Path> = replaced
+        .iter()
+        .map(|(target, _)| target.parent().unwrap_or(Path::new(".")))
+        .collect();
+    folders.sort();
+    folders.dedup();
+    for folder in folders {
+        let synced = before(SaveStep::SyncFolder).and_then(|()| sync_folder(folder));
+        if let Err(e) = synced {
+            return Err((folder.to_path_buf(), SaveFailure::NotDurable(e)));
+        }
+    }
+    Ok(())
+}
+
+/// The file a path names, through any symbolic links (the path itself if it does not
+/// exist yet).
+fn resolve_links(path: &Path) -> std::io::Result<PathBuf> {
+    match std::fs::canonicalize(path) {
+        Ok(target) => Ok(target),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            // A dangling link is written through to where it points.
+            match std::fs::read_link(path) {
+                Ok(points_to) => Ok(path.parent().unwrap_or(Path::new(".")).join(points_to)),
+                Err(_) => Ok(path.to_path_buf()),
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// `bytes` in a synced temporary file beside `target`, with `target`'s permissions.
+fn write_temporary(target: &Path, bytes: &[u8]) -> std::io::Result<tempfile::NamedTempFile> {
+    let dir = target
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
@@ -333,12 +515,62 @@ pub fn write_atomic(
         .tempfile_in(dir)?;
     temp.write_all(bytes)?;
     temp.flush()?;
+    let permissions = match std::fs::metadata(target) {
+        Ok(meta) => meta.permissions(),
+        // A new file: as the user's files are (0644 under the usual umask), not tempfile's
+        // private 0600.
+        Err(_) => default_permissions(),
+    };
+    temp.as_file().set_permissions(permissions)?;
     temp.as_file().sync_all()?;
-    // On error the temporary file is removed when `temp` drops.
-    before_rename(temp.path())?;
-    temp.persist(path).map_err(|e| e.error)?;
-    #[cfg(unix)]
-    std::fs::File::open(dir)?.sync_all()?;
+    Ok(temp)
+}
+
+#[cfg(unix)]
+fn default_permissions() -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    // SAFETY: umask is read by setting it and setting it back.
+    let umask = unsafe {
+        let mask = libc::umask(0o022);
+        libc::umask(mask);
+        mask
+    };
+    std::fs::Permissions::from_mode(0o666 & !(umask as u32))
+}
+
+#[cfg(not(unix))]
+fn default_permissions() -> std::fs::Permissions {
+    std::fs::metadata(".")
+        .map(|m| m.permissions())
+        .unwrap_or_else(|_| {
+            std::fs::File::open(".")
+                .and_then(|f| f.metadata())
+                .expect("the current folder")
+                .permissions()
+        })
+}
+
+/// A backup of `target` beside it (None: there is no file yet), kept until the save ends.
+fn keep_backup(target: &Path) -> std::io::Result<Option<PathBuf>> {
+    if !target.exists() {
+        return Ok(None);
+    }
+    let name = target.file_name().unwrap_or_default().to_string_lossy();
+    let backup = target.with_file_name(format!(".robosim-backup-{name}"));
+    let _ = std::fs::remove_file(&backup);
+    if std::fs::hard_link(target, &backup).is_err() {
+        std::fs::copy(target, &backup)?;
+    }
+    Ok(Some(backup))
+}
+
+#[cfg(unix)]
+fn sync_folder(folder: &Path) -> std::io::Result<()> {
+    std::fs::File::open(folder)?.sync_all()
+}
+
+#[cfg(not(unix))]
+fn sync_folder(_folder: &Path) -> std::io::Result<()> {
     Ok(())
 }
 

@@ -24,7 +24,7 @@ pub struct Problem {
 
 /// `text` on one line: control characters (a newline in a name, in a tag that the XML
 /// parser quotes) written as escapes, so that a problem always prints as one line.
-fn one_line(text: String) -> String {
+pub fn one_line(text: String) -> String {
     if !text.chars().any(char::is_control) {
         return text;
     }
@@ -61,6 +61,12 @@ impl Problem {
         if location.line > 0 {
             self.location = Some(location);
         }
+        self
+    }
+
+    /// The same problem, its message continued.
+    pub fn with_message_suffix(mut self, suffix: &str) -> Self {
+        self.message.push_str(&one_line(suffix.to_string()));
         self
     }
 

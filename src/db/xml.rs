@@ -1,7 +1,7 @@
 //! XML syntax only: a file's text becomes a small tree of elements with their attributes
 //! and line/column, or one syntax problem. What the elements mean is `read.rs`'s business.
 
-use super::problem::Problem;
+use super::problem::{Problem, one_line};
 use crate::model::Location;
 use quick_xml::XmlVersion;
 use quick_xml::events::{BytesStart, Event};
@@ -23,10 +23,14 @@ pub struct Lines {
 }
 
 impl Lines {
+    /// Lines end at `\n`, `\r\n` or a lone `\r` (old Mac files).
     pub fn new(text: &str) -> Self {
-        let starts = std::iter::once(0)
-            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
-            .collect();
+        let bytes = text.as_bytes();
+        let ends = bytes
+            .iter()
+            .enumerate()
+            .filter(|&(i, &b)| b == b'\n' || (b == b'\r' && bytes.get(i + 1) != Some(&b'\n')));
+        let starts = std::iter::once(0).chain(ends.map(|(i, _)| i + 1)).collect();
         Self { starts }
     }
 
@@ -40,63 +44,253 @@ impl Lines {
     }
 }
 
-/// Decodes the bytes of a file as UTF-8 (a leading byte-order mark is skipped).
-pub fn decode<'a>(bytes: &'a [u8], file: &str) -> Result<&'a str, Problem> {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    std::str::from_utf8(bytes).map_err(|e| {
-        let valid = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or_default();
-        let location = Lines::new(valid).locate(valid.len());
-        Problem::error(
+/// A file's text: UTF-8 as it is, or decoded from the encoding its byte-order mark or XML
+/// declaration names (the thesis's application ran on Czech Windows: `windows-1250`),
+/// with a warning that saving writes it as UTF-8.
+pub struct Decoded<'a> {
+    pub text: std::borrow::Cow<'a, str>,
+    pub warning: Option<Problem>,
+}
+
+/// Decodes the bytes of a file: a byte-order mark (UTF-8, UTF-16) or the declaration's
+/// `encoding` says how; without either, UTF-8.
+pub fn decode<'a>(bytes: &'a [u8], file: &str) -> Result<Decoded<'a>, Problem> {
+    let (encoding, bom) = match encoding_rs::Encoding::for_bom(bytes) {
+        Some((encoding, bom)) => (encoding, bom),
+        None => (declared_encoding(bytes).unwrap_or(encoding_rs::UTF_8), 0),
+    };
+    let body = &bytes[bom..];
+    if encoding == encoding_rs::UTF_8 {
+        let text = std::str::from_utf8(body).map_err(|e| {
+            let valid = std::str::from_utf8(&body[..e.valid_up_to()]).unwrap_or_default();
+            let location = Lines::new(valid).locate(valid.len());
+            Problem::error(
+                file,
+                "file",
+                format!(
+                    "not valid UTF-8 (byte {} of the file)",
+                    bom + e.valid_up_to() + 1
+                ),
+            )
+            .at(location)
+        })?;
+        return Ok(Decoded {
+            text: std::borrow::Cow::Borrowed(text),
+            warning: None,
+        });
+    }
+    let (text, had_errors) = encoding.decode_without_bom_handling(body);
+    if had_errors {
+        return Err(Problem::error(
             file,
             "file",
-            format!("not valid UTF-8 (byte {} of the file)", e.valid_up_to() + 1),
-        )
-        .at(location)
+            format!("not valid {} (the encoding it declares)", encoding.name()),
+        ));
+    }
+    let warning = Problem::warning(
+        file,
+        "file",
+        format!(
+            "encoded as {}: read as such, and saved as UTF-8",
+            encoding.name()
+        ),
+    );
+    Ok(Decoded {
+        text: std::borrow::Cow::Owned(text.into_owned()),
+        warning: Some(warning),
     })
 }
 
-/// Parses `text` into its root element.
-pub fn parse(text: &str, file: &str) -> Result<Element, Problem> {
+/// The encoding an XML declaration at the start of `bytes` names, if it names one
+/// encoding_rs knows. (The declaration is ASCII in every encoding a database may use
+/// without a byte-order mark.)
+fn declared_encoding(bytes: &[u8]) -> Option<&'static encoding_rs::Encoding> {
+    let head = &bytes[..bytes.len().min(256)];
+    let head = std::str::from_utf8(head)
+        .or_else(|e| std::str::from_utf8(&head[..e.valid_up_to()]))
+        .ok()?;
+    let declaration = head.strip_prefix("<?xml")?;
+    let declaration = &declaration[..declaration.find("?>")?];
+    let at = declaration.find("encoding")?;
+    let rest = declaration[at + "encoding".len()..].trim_start();
+    let rest = rest.strip_prefix('=')?.trim_start();
+    let quote = rest.chars().next().filter(|q| *q == '"' || *q == '\'')?;
+    let label = &rest[1..][..rest[1..].find(quote)?];
+    encoding_rs::Encoding::for_label(label.trim().as_bytes())
+}
+
+/// What parsing a file gave: its root and the records skipped for their syntax.
+pub struct Parsed {
+    pub root: Element,
+    /// One error per record skipped, and warnings for what was ignored (stray text).
+    pub problems: Vec<Problem>,
+    pub skipped: bool,
+}
+
+/// A syntax error, and the record (a child of the root) it lies in: where the record's
+/// tag starts, and its name.
+struct SyntaxError {
+    problem: Box<Problem>,
+    record: Option<(usize, String)>,
+}
+
+/// Records skipped for their syntax before a file is given up as unreadable: each one
+/// reads the file again.
+const MAX_SKIPPED_RECORDS: usize = 32;
+
+/// Parses `text` into its root element, record by record: a syntax error inside one of
+/// the root's children (a duplicated attribute, an unknown entity, a broken tag) skips
+/// that record with an error naming it, and the rest of the file still loads; a file cut
+/// off after its last whole record loads those. An error outside every record (no root,
+/// two roots) loses the file, with the problems found until then.
+pub fn parse(text: &str, file: &str) -> Result<Parsed, Vec<Problem>> {
+    let mut text = std::borrow::Cow::Borrowed(text);
+    let mut problems = Vec::new();
+    let mut skipped = false;
+    loop {
+        // Each attempt reads the file anew: only the last one's warnings stand.
+        let mut warnings = Vec::new();
+        match parse_once(&text, file, &mut warnings) {
+            Ok((root, truncated)) => {
+                problems.extend(warnings);
+                problems.sort_by_key(|p| p.location.map(|l| (l.line, l.column)));
+                return Ok(Parsed {
+                    root,
+                    problems,
+                    skipped: skipped || truncated,
+                });
+            }
+            Err(SyntaxError {
+                problem,
+                record: Some(_),
+            }) if problems.len() >= MAX_SKIPPED_RECORDS => {
+                problems.push((*problem).with_message_suffix(&format!(
+                    "; more than {MAX_SKIPPED_RECORDS} records are broken: the file is not read"
+                )));
+                return Err(problems);
+            }
+            Err(SyntaxError {
+                problem,
+                record: Some((start, name)),
+            }) => {
+                problems.push((*problem).with_message_suffix("; the record is skipped"));
+                skipped = true;
+                // Blanked rather than cut, so that every later line keeps its number.
+                let end = next_record(&text, start, &name);
+                let mut bytes = text.into_owned().into_bytes();
+                for b in &mut bytes[start..end] {
+                    if *b != b'\n' && *b != b'\r' {
+                        *b = b' ';
+                    }
+                }
+                text = std::borrow::Cow::Owned(
+                    String::from_utf8(bytes).expect("blanked with ASCII spaces"),
+                );
+            }
+            Err(SyntaxError { problem, .. }) => {
+                problems.push(*problem);
+                return Err(problems);
+            }
+        }
+    }
+}
+
+/// Where the record that starts at `start` ends for skipping it: after its own end tag
+/// if that comes before the next tag of the same name; else at that next tag, or the
+/// root's end tag, or the end of the text.
+fn next_record(text: &str, start: usize, name: &str) -> usize {
+    let after = start + 1;
+    let open = format!("<{name}");
+    let next = text[after..]
+        .match_indices(&open)
+        .map(|(i, _)| after + i)
+        .find(|&i| {
+            let follows = text[i + open.len()..].chars().next();
+            follows.is_none_or(|c| c.is_whitespace() || c == '>' || c == '/')
+        });
+    let own_end = format!("</{name}>");
+    let closed = text[after..]
+        .find(&own_end)
+        .map(|i| after + i + own_end.len())
+        .filter(|&end| next.is_none_or(|n| end <= n));
+    let root_end = text[after..].rfind("</").map(|i| after + i);
+    closed
+        .or(next.map(|n| root_end.map_or(n, |r| n.min(r))))
+        .or(root_end)
+        .unwrap_or(text.len())
+}
+
+/// One reading of `text`: its root, and whether the file was cut off after its last whole
+/// record (its root never closed: reported in `problems`).
+fn parse_once(
+    text: &str,
+    file: &str,
+    problems: &mut Vec<Problem>,
+) -> Result<(Element, bool), SyntaxError> {
     let lines = Lines::new(text);
     let mut reader = quick_xml::Reader::from_str(text);
     reader.config_mut().trim_text(true);
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
+    // The record (a child of the root) being read: where its tag starts, and its name.
+    let mut record: Option<(usize, String)> = None;
+    let fail = |problem: Problem, record: &Option<(usize, String)>| SyntaxError {
+        problem: Box::new(problem),
+        record: record.clone(),
+    };
     loop {
         let before = reader.buffer_position() as usize;
         let tag_start = before + text[before.min(text.len())..].len()
             - text[before.min(text.len())..].trim_start().len();
         let location = lines.locate(tag_start);
-        let event = reader.read_event().map_err(|e| {
-            Problem::error(file, "file", format!("malformed XML: {e}"))
-                .at(lines.locate(reader.error_position() as usize))
-        })?;
+        let event = match reader.read_event() {
+            Ok(event) => event,
+            Err(e) => {
+                let at = lines.locate(reader.error_position() as usize);
+                let problem = Problem::error(file, "file", format!("malformed XML: {e}")).at(at);
+                return Err(fail(problem, &record));
+            }
+        };
+        // A tag of the root's own children starts a record.
+        let starts_record = |stack: &Vec<Element>| stack.len() == 1;
         match event {
             Event::Start(start) | Event::Empty(start) if root.is_some() && stack.is_empty() => {
                 let name = start.name().into_inner().to_string();
-                return Err(Problem::error(
+                let problem = Problem::error(
                     file,
                     &format!("<{name}>"),
                     "a second root element (a file has one)",
                 )
-                .at(location));
+                .at(location);
+                return Err(fail(problem, &None));
             }
             Event::Start(start) => {
+                if starts_record(&stack) {
+                    record = Some((tag_start, tag_name(&start)));
+                }
                 if stack.len() >= MAX_DEPTH {
-                    return Err(Problem::error(
+                    let problem = Problem::error(
                         file,
                         "file",
                         format!("elements nested deeper than {MAX_DEPTH}"),
                     )
-                    .at(location));
+                    .at(location);
+                    return Err(fail(problem, &record));
                 }
-                stack.push(element(&start, location, file)?);
+                let element = element(&start, location, file).map_err(|p| fail(p, &record))?;
+                stack.push(element);
             }
             Event::Empty(start) => {
-                let done = element(&start, location, file)?;
+                if starts_record(&stack) {
+                    record = Some((tag_start, tag_name(&start)));
+                }
+                let done = element(&start, location, file).map_err(|p| fail(p, &record))?;
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(done),
                     None => root = Some(done),
+                }
+                if stack.len() == 1 {
+                    record = None;
                 }
             }
             Event::End(_) => {
@@ -106,23 +300,23 @@ pub fn parse(text: &str, file: &str) -> Result<Element, Problem> {
                     Some(parent) => parent.children.push(done),
                     None => root = Some(done),
                 }
+                if stack.len() == 1 {
+                    record = None;
+                }
             }
             Event::Text(t) => {
                 let content = t.xml_content(XmlVersion::Implicit1_0);
                 if !content.trim().is_empty() {
-                    let inside = stack
-                        .last()
-                        .map_or("file".to_string(), |e| format!("<{}>", e.name));
-                    return Err(Problem::error(
+                    problems.push(ignored(
                         file,
-                        &inside,
-                        format!("unexpected text {:?}", clip(&content)),
-                    )
-                    .at(location));
+                        &stack,
+                        format!("text {:?}", clip(&content)),
+                        location,
+                    ));
                 }
             }
             Event::CData(_) => {
-                return Err(Problem::error(file, "file", "unexpected CDATA section").at(location));
+                problems.push(ignored(file, &stack, "CDATA section".into(), location));
             }
             Event::Eof => break,
             Event::Decl(_)
@@ -134,7 +328,7 @@ pub fn parse(text: &str, file: &str) -> Result<Element, Problem> {
     }
     if let Some(open) = stack.last() {
         let end = lines.locate(text.len());
-        return Err(Problem::error(
+        let problem = Problem::error(
             file,
             &format!("<{}>", open.name),
             format!(
@@ -142,9 +336,40 @@ pub fn parse(text: &str, file: &str) -> Result<Element, Problem> {
                 open.name, open.location.line
             ),
         )
-        .at(end));
+        .at(end);
+        if stack.len() >= 2 {
+            // A truncated record is skipped like any broken one.
+            return Err(fail(problem, &record));
+        }
+        // The root alone is open: its whole records load.
+        problems.push(problem);
+        let root = stack.pop().expect("the root is open");
+        return Ok((root, true));
     }
-    root.ok_or_else(|| Problem::error(file, "file", "no root element (the file is empty)"))
+    match root {
+        Some(root) => Ok((root, false)),
+        None => Err(fail(
+            Problem::error(file, "file", "no root element (the file is empty)"),
+            &None,
+        )),
+    }
+}
+
+fn tag_name(start: &BytesStart) -> String {
+    start.name().into_inner().to_string()
+}
+
+/// A warning for something the reader ignores (and saving does not keep).
+fn ignored(file: &str, stack: &[Element], what: String, location: Location) -> Problem {
+    let inside = stack
+        .last()
+        .map_or("file".to_string(), |e| format!("<{}>", e.name));
+    Problem::warning(
+        file,
+        &inside,
+        format!("unexpected {what}, ignored (and not kept when this file is saved)"),
+    )
+    .at(location)
 }
 
 fn element(start: &BytesStart, location: Location, file: &str) -> Result<Element, Problem> {
@@ -171,13 +396,14 @@ fn element(start: &BytesStart, location: Location, file: &str) -> Result<Element
     })
 }
 
-/// A value shortened for a message.
+/// A value shortened for a message, its control characters escaped (`\n`, `\u{1b}`):
+/// a message is one line, and a name from a file must not move the terminal's cursor.
 pub fn clip(value: &str) -> String {
     const MAX: usize = 40;
     if value.chars().count() <= MAX {
-        value.to_string()
+        one_line(value.to_string())
     } else {
         let head: String = value.chars().take(MAX).collect();
-        format!("{head}… ({} characters)", value.chars().count())
+        format!("{}… ({} characters)", one_line(head), value.chars().count())
     }
 }

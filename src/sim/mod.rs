@@ -3,7 +3,7 @@
 
 pub mod trace;
 
-use crate::db::{self, beyond_all, limits};
+use crate::db::{self, beyond_all, clip, limits};
 use crate::model::{Model, Placement, Scene, same_name};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
 
@@ -79,6 +79,23 @@ pub struct Simulation {
     solver: ContactSolver,
 }
 
+/// Trace ids made unique in order: an id already taken gets `~2`, `~3`, ... (a scene
+/// body aliased `r#0/a` beside robot `r`'s body `a`, two joints between the same two
+/// bodies), so that no two columns of a trace share a name.
+fn make_unique<'a>(ids: impl Iterator<Item = &'a mut String>) {
+    let mut taken = std::collections::HashSet::new();
+    for id in ids {
+        if !taken.insert(id.clone()) {
+            let unique = (2..)
+                .map(|k| format!("{id}~{k}"))
+                .find(|candidate| !taken.contains(candidate))
+                .expect("some suffix is free");
+            taken.insert(unique.clone());
+            *id = unique;
+        }
+    }
+}
+
 /// A placement composed with a parent frame (`model::compose`), as a position and angle.
 fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (Vec2, f64) {
     let (x, y, angle) = crate::model::compose(frame, local);
@@ -99,15 +116,16 @@ impl Simulation {
     ) -> Result<Self, BuildError> {
         let scene = model
             .scene(name)
-            .ok_or_else(|| BuildError::UnknownScene(name.to_string()))?;
+            .ok_or_else(|| BuildError::UnknownScene(clip(name)))?;
         let invalid = |problem: String| BuildError::Invalid {
-            scene: scene.name.clone(),
+            scene: clip(&scene.name),
             problem,
         };
         let dt = dt.unwrap_or(scene.timestep());
         if !(db::TIMESTEP_RANGE.0..=db::TIMESTEP_RANGE.1).contains(&dt) {
             return Err(invalid(format!(
-                "the step {dt} s is outside [{}, {}] s",
+                "the step {} s is outside [{}, {}] s",
+                db::write::number(dt),
                 db::TIMESTEP_RANGE.0,
                 db::TIMESTEP_RANGE.1
             )));
@@ -303,6 +321,8 @@ impl Simulation {
         // Scenes are in pixels, tens of units per body, not metres: tolerances scale with
         // the typical body.
         self.world.settings.length_scale = self.world.median_body_radius().unwrap_or(1.0);
+        make_unique(self.bodies.iter_mut().map(|b| &mut b.id));
+        make_unique(self.joints.iter_mut().map(|j| &mut j.id));
         Ok(())
     }
 
@@ -328,8 +348,14 @@ impl Simulation {
         self.step_count() as f64 * self.dt
     }
 
-    /// One step of `dt`; joint motors switch on and off by their windows.
+    /// One step of `dt` (see `try_step`), whatever it reports.
     pub fn step(&mut self) {
+        let _reported = self.try_step();
+    }
+
+    /// One step of `dt`; joint motors switch on and off by their windows. An error names
+    /// what pe refused, or the body whose state left the limits (by its trace id).
+    pub fn try_step(&mut self) -> Result<(), String> {
         let step = self.world.step_count();
         for j in &self.joints {
             if let Some((t0, t1, _)) = j.motor_window
@@ -341,7 +367,14 @@ impl Simulation {
                 }
             }
         }
-        self.world.step(self.dt);
+        self.world.try_step(self.dt).map_err(|e| match e {
+            pe::StepError::StateBeyond { body, .. } => {
+                let id = self.bodies.iter().find(|b| b.handle.0 == body);
+                let name = id.map_or(format!("body {body}"), |b| format!("\"{}\"", clip(&b.id)));
+                e.to_string().replacen(&format!("body {body}"), &name, 1)
+            }
+            e => e.to_string(),
+        })
     }
 
     pub fn metrics(&self) -> Metrics {

@@ -2,7 +2,7 @@
 
 use super::SolverBody;
 use crate::collide::FeatureId;
-use crate::math::{Vec2, cross, perp};
+use crate::math::{Vec2, clamp, cross, perp};
 
 /// The last solve's contact impulses by (body A, body B, feature), for warm starting the
 /// next: kept in contact order, which is by body pair as the broad phase lists pairs.
@@ -263,7 +263,7 @@ pub fn solve_sequential(
         let t_dir = c.tangent();
         let k_t = c.coupling(t_dir, c, t_dir, bodies);
         let v_t = v.dot(&t_dir) + j * c.coupling(t_dir, c, c.normal, bodies);
-        let t = (-v_t / k_t).clamp(-c.friction * j, c.friction * j);
+        let t = clamp(-v_t / k_t, -c.friction * j, c.friction * j);
         c.apply(bodies, j, t);
         c.normal_impulse = j;
         c.tangent_impulse = t;

@@ -3,7 +3,7 @@
 use super::SolverBody;
 use super::island::{UnionFind, group_by_island};
 use crate::body::BodyHandle;
-use crate::math::{Rot, Vec2};
+use crate::math::{Rot, Vec2, clamp};
 use nalgebra::{DMatrix, DVector};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
@@ -297,8 +297,11 @@ fn drive_motors_continue(
             }
             let relative = bodies[ia].angular_velocity - bodies[ib].angular_velocity;
             let limit = motor.max_torque * dt;
-            let total =
-                (motor.last_impulse - (relative - motor.target_speed) / k).clamp(-limit, limit);
+            let total = clamp(
+                motor.last_impulse - (relative - motor.target_speed) / k,
+                -limit,
+                limit,
+            );
             let delta = total - motor.last_impulse;
             motor.last_impulse = total;
             bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;

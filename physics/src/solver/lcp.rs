@@ -17,6 +17,8 @@
 //! give well-conditioned pivots. A pivot cap and a projected Gauss–Seidel fallback make it
 //! always terminate.
 
+use crate::math::clamp;
+
 /// One problem. `a` is row-major `n×n`.
 #[derive(Debug, Clone, Copy)]
 pub struct LcpProblem<'a> {
@@ -151,10 +153,14 @@ const GUESS_AT_BOUND: f64 = 1e-4;
 /// robots in motion take up to 5.3 per row in a step (the default database's, 1,000
 /// steps each), Box2D's arch 6.2 in its first step.
 const PIVOT_BUDGET_PER_ROW: usize = 8;
-/// Projected Gauss–Seidel sweeps of the fallback, and the change (in scaled impulse units,
-/// where the diagonal is 1) below which it stops early.
+/// Projected Gauss–Seidel sweeps of the fallback, and the change (relative to the largest
+/// impulse) below which it stops early.
 const PGS_SWEEPS: usize = 200;
 const PGS_TOLERANCE: f64 = 1e-10;
+/// The LCP conditions are checked within this much of the problem's scale (its largest
+/// `b`): tolerances relative to the problem, so that a problem of tiny numbers (a body of
+/// density 1e-20, whose impulses are 1e-18) is held to them as one of ordinary numbers.
+const CHECK_TOLERANCE: f64 = 1e-9;
 
 impl LcpSolver {
     /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
@@ -328,8 +334,8 @@ impl LcpSolver {
             self.x[i] = self.rhs[k];
         }
         self.compute_w();
-        let scale = 1.0 + self.b.iter().map(|v| v.abs()).fold(0.0, f64::max);
-        let tolerance = 1e-9 * scale;
+        let scale = self.b.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let tolerance = CHECK_TOLERANCE * scale;
         let valid = (0..n).all(|i| match self.set[i] {
             Set::Clamped => {
                 self.x[i].is_finite()
@@ -345,7 +351,7 @@ impl LcpSolver {
             return false;
         }
         for &i in &self.clamped {
-            self.x[i] = self.x[i].clamp(self.lo[i], self.hi[i]);
+            self.x[i] = clamp(self.x[i], self.lo[i], self.hi[i]);
         }
         true
     }
@@ -703,11 +709,12 @@ impl LcpSolver {
                 let row = &self.a[i * n..(i + 1) * n];
                 let w: f64 = row.iter().zip(&self.x).map(|(a, x)| a * x).sum::<f64>() + self.b[i];
                 let diagonal = row[i].max(REGULARISATION);
-                let new = (self.x[i] - w / diagonal).clamp(self.lo[i], self.hi[i]);
+                let new = clamp(self.x[i] - w / diagonal, self.lo[i], self.hi[i]);
                 change = change.max((new - self.x[i]).abs());
                 self.x[i] = new;
             }
-            if change < PGS_TOLERANCE {
+            let size = self.x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            if change <= PGS_TOLERANCE * size {
                 break;
             }
         }

@@ -8,6 +8,7 @@ use super::island::{UnionFind, group_by_island};
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+use crate::math::clamp;
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
 /// dense pivoting method, whose cost grows as n³. Measured by `examples/dense_threshold.rs`
@@ -470,7 +471,7 @@ impl SimultaneousSolver {
                     None => (row.lo, row.hi),
                 };
                 let w = row.velocity(scratch) + self.b[i];
-                let new = (self.x[i] - w / diagonal).clamp(lo, hi);
+                let new = clamp(self.x[i] - w / diagonal, lo, hi);
                 let delta = new - self.x[i];
                 if delta != 0.0 {
                     row.apply(scratch, delta);

@@ -14,7 +14,7 @@ use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use super::simultaneous::{IslandMethod, IslandReport};
-use crate::math::{Rot, Vec2, cross, cross_scalar, perp};
+use crate::math::{Rot, Vec2, clamp, cross, cross_scalar, greater, lesser, perp};
 use crate::stage_clock::{self, Stage};
 use batch::{AskedFor, LaneBatch, LanePath, PassItem, PassPlan, PassSettings, PlanInput};
 use pins::{PinPass, PinPlan};
@@ -62,6 +62,9 @@ pub struct SoftSettings {
     pub joint_damping_ratio: f64,
     /// The fastest a soft contact pushes overlapping bodies apart (length units / s).
     pub max_push_speed: f64,
+    /// The deepest a soft contact lets its bodies sink in one substep's biased pass
+    /// (length units): see `sinking_floor`.
+    pub max_soft_depth: f64,
     /// The fastest a soft pin pulls its anchors together (length units / s).
     pub joint_push_speed: f64,
     /// Whether every other pair of substeps sweeps the colours backwards (`SweepOrder`).
@@ -77,6 +80,7 @@ impl SoftSettings {
             joint_hertz: 60.0,
             joint_damping_ratio: 2.0,
             max_push_speed: 3.0 * length_scale,
+            max_soft_depth: 0.1 * length_scale,
             // Far faster than contacts: a loaded net of pins (100 × 100, hanging from
             // seven) opened to 16 m with pins capped at 3 length scales per second, and
             // to 0.49 m (as Box2D v3's, which has no cap) at 100.
@@ -573,6 +577,7 @@ fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool
             h,
         ),
         max_push: settings.max_push_speed,
+        max_depth: settings.max_soft_depth,
         use_bias,
     }
 }
@@ -585,7 +590,7 @@ fn integrate_velocity(b: &mut SoftBody, (linear, angular): (Vec2, f64), h: f64) 
     // rotation below (and any contact found at the step's start) can follow; like Box2D,
     // cap the spin there rather than let it overflow to NaN.
     let max_w = MAX_TURN_PER_SUBSTEP / h;
-    b.w = b.w.clamp(-max_w, max_w);
+    b.w = clamp(b.w, -max_w, max_w);
 }
 
 /// A body's motion since the step's start, over a substep of `h`.
@@ -1690,15 +1695,26 @@ fn point_target(
     normal_target(separation(a, b, p), pass, !(a.moves() && b.moves()))
 }
 
+/// The least normal velocity a point may keep in a biased pass: a soft spring lets a part
+/// of the approach through (1 − its mass scale), and where that would carry the point
+/// deeper than `max_depth` within the substep, it is held there rigidly. Ordinary scenes
+/// never come near it; a box on the floor at a gravity of 1e5 and h = 1 (a hundred
+/// thousand times its size each step) fell through in the first step without it.
+#[inline(always)]
+fn sinking_floor(separation: f64, pass: &PassSettings) -> f64 {
+    lesser(-(pass.max_depth + separation) * pass.inv_h, 0.0)
+}
+
 fn solve_point(bodies: &mut [SoftBody], p: &mut PointConstraint, pass: &PassSettings) {
     let (target, softness, separation) = point_target(bodies, p, pass);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
-    solve_normal(&mut pair, p, target, softness, separation);
+    solve_normal(&mut pair, p, target, softness, separation, pass);
     solve_friction(&mut pair, p);
     pair.store(bodies);
 }
 
-/// One point's normal row alone: soft towards `target` with the softness scales.
+/// One point's normal row alone: soft towards `target` with the softness scales (in a
+/// biased pass, no softer than `sinking_floor`).
 #[inline(always)]
 fn solve_normal(
     pair: &mut BodyPair,
@@ -1706,10 +1722,17 @@ fn solve_normal(
     target: f64,
     (mass_scale, impulse_scale): (f64, f64),
     separation: f64,
+    pass: &PassSettings,
 ) {
     let vn = approach(pair, p, separation);
     let pushed = -p.normal_mass * mass_scale * (vn - target);
-    let impulse = (-impulse_scale).mul_add(p.normal_impulse, pushed);
+    let mut impulse = (-impulse_scale).mul_add(p.normal_impulse, pushed);
+    if pass.use_bias {
+        impulse = greater(
+            impulse,
+            -p.normal_mass * (vn - sinking_floor(separation, pass)),
+        );
+    }
     apply_normal(pair, p, p.normal_impulse + impulse);
 }
 
@@ -1718,9 +1741,11 @@ fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
     let t = perp(p.normal);
     let vt = pair.velocity_along(t, p.levers.tangent());
     let limit = p.friction * p.normal_impulse;
-    let total = (-p.tangent_mass)
-        .mul_add(vt, p.tangent_impulse)
-        .clamp(-limit, limit);
+    let total = clamp(
+        (-p.tangent_mass).mul_add(vt, p.tangent_impulse),
+        -limit,
+        limit,
+    );
     let delta = total - p.tangent_impulse;
     p.tangent_impulse = total;
     pair.apply_along(t, p.levers.tangent(), delta);
@@ -1745,8 +1770,17 @@ fn solve_pair(
         let (v1, v2) = (approach(&pair, p, dp), approach(&pair, q, dq));
         solve_normal_pair(&mut pair, (p, q), (v1, v2), (tp, tq));
     } else {
-        solve_normal(&mut pair, p, tp, sp, dp);
-        solve_normal(&mut pair, q, tq, sq, dq);
+        solve_normal(&mut pair, p, tp, sp, dp, pass);
+        solve_normal(&mut pair, q, tq, sq, dq, pass);
+        // One point after the other, the second's push can undo the first's: where that
+        // leaves either below its floor, both are pushed up to their floors together.
+        let below = (
+            pair.normal_velocity(p) - sinking_floor(dp, pass),
+            pair.normal_velocity(q) - sinking_floor(dq, pass),
+        );
+        if below.0 < 0.0 || below.1 < 0.0 {
+            push_to_floors(&mut pair, (p, q), below);
+        }
     }
     solve_friction(&mut pair, p);
     solve_friction(&mut pair, q);
@@ -1795,6 +1829,33 @@ fn solve_normal_pair(
     apply_normal(pair, q, totals.1);
 }
 
+/// The least further pushes x ≥ 0 on a manifold's two points that lift their normal
+/// velocities to their floors: w = K x + r ≥ 0, x·w = 0, with `r` the velocities less
+/// the floors (`solve_normal_pair`'s four active sets).
+#[inline(always)]
+fn push_to_floors(
+    pair: &mut BodyPair,
+    (p, q): (&mut PointConstraint, &mut PointConstraint),
+    (r1, r2): (f64, f64),
+) {
+    let block = p.pair_coupling.expect("paired points");
+    let (i11, i12, i22) = block.inverse;
+    let k12 = block.k12;
+    let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
+    let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
+    let pushes = if both.0 >= 0.0 && both.1 >= 0.0 {
+        both
+    } else if first >= 0.0 && k12.mul_add(first, r2) >= 0.0 {
+        (first, 0.0)
+    } else if second >= 0.0 && k12.mul_add(second, r1) >= 0.0 {
+        (0.0, second)
+    } else {
+        (0.0, 0.0)
+    };
+    apply_normal(pair, p, p.normal_impulse + pushes.0);
+    apply_normal(pair, q, q.normal_impulse + pushes.1);
+}
+
 /// A joint motor: the relative spin driven towards its target, within ±max torque·h.
 fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
     if let Some((target, max_torque)) = j.motor {
@@ -1802,7 +1863,7 @@ fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
         let k = a.inv_inertia + b.inv_inertia;
         if k > 0.0 {
             let limit = max_torque * h;
-            let total = (j.motor_impulse - (a.w - b.w - target) / k).clamp(-limit, limit);
+            let total = clamp(j.motor_impulse - (a.w - b.w - target) / k, -limit, limit);
             let delta = total - j.motor_impulse;
             j.motor_impulse = total;
             bodies[j.a as usize].w += a.inv_inertia * delta;

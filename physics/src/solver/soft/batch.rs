@@ -1086,6 +1086,8 @@ pub(super) struct PassSettings {
     /// The softness of contacts with a fixed body.
     pub static_soft: Softness,
     pub max_push: f64,
+    /// `SoftSettings::max_soft_depth`.
+    pub max_depth: f64,
     pub use_bias: bool,
 }
 
@@ -1519,6 +1521,7 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             let bounce = BOUNCE.then_some(&mut self.bounce[..]);
             let points = (&self.points[..], &mut self.normal_impulses[..], bounce);
             solve_normals_alone::<L, BIAS>(pair, points, normal, separations, targets);
+            self.push_to_floors::<BOUNCE>(pair, targets);
             return;
         }
         // Copied before the block changes them: the velocities and impulses, and the
@@ -1540,6 +1543,46 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
                 let fastest = rigid.select(p.relative_velocity, q.relative_velocity);
                 p.relative_velocity.set(fastest);
             }
+        }
+        self.push_to_floors::<BOUNCE>(pair, targets);
+    }
+
+    /// `push_to_floors` on every lane where a point sank below its floor (a lane that
+    /// did not gets nothing: its rows' LCP is solved by no push).
+    #[inline(always)]
+    fn push_to_floors<const BOUNCE: bool>(
+        &mut self,
+        pair: &mut LanePair<L>,
+        targets: &[Target<L>],
+    ) {
+        let zero = L::splat(0.0);
+        let normal = (self.normal_x, self.normal_y);
+        let points = &self.points[..];
+        let v1 = pair.velocity_along(normal, points[0].normal_lever_a, points[0].normal_lever_b);
+        let v2 = pair.velocity_along(normal, points[1].normal_lever_a, points[1].normal_lever_b);
+        let (r1, r2) = (v1 - targets[0].3, v2 - targets[1].3);
+        let (below1, below2) = (r1.lt(zero), r2.lt(zero));
+        // a | b as (a ^ b) ^ (a & b): the masks have no "or".
+        if !((below1 ^ below2) ^ (below1 & below2)).any() {
+            return;
+        }
+        let [i11, i12, i22] = self.inverse;
+        let k12 = self.k12;
+        let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
+        let first = -r1 * points[0].normal_mass;
+        let second = -r2 * points[1].normal_mass;
+        let take_both = both.0.ge(zero) & both.1.ge(zero);
+        let take_first = first.ge(zero) & k12.mul_add(first, r2).ge(zero);
+        let take_second = second.ge(zero) & k12.mul_add(second, r1).ge(zero);
+        let push1 = take_both.select(both.0, take_first.select(first, zero));
+        let push2 = take_both.select(
+            both.1,
+            take_first.select(zero, take_second.select(second, zero)),
+        );
+        let points = self.points.iter().zip(&mut self.normal_impulses);
+        for (((p, impulse), bounce), push) in points.zip(&mut self.bounce).zip([push1, push2]) {
+            let total = *impulse + push;
+            apply_normal(pair, (p, impulse), BOUNCE.then_some(bounce), normal, total);
         }
     }
 
@@ -1669,13 +1712,19 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
             } else {
                 (zero, one, zero)
             };
+            let floor = if BIAS {
+                (-(L::splat(pass.max_depth) + s) * L::splat(pass.inv_h)).min(zero)
+            } else {
+                L::splat(f64::NEG_INFINITY)
+            };
             (
                 speculative.select(-s * L::splat(pass.inv_h), target),
                 speculative.select(one, mass_scale),
                 speculative.select(zero, impulse_scale),
+                floor,
             )
         };
-        let mut targets = [(zero, zero, zero); N];
+        let mut targets = [(zero, zero, zero, zero); N];
         for (t, &s) in targets.iter_mut().zip(&separations) {
             *t = target(s);
         }
@@ -1735,7 +1784,9 @@ fn unused_lane(null_body: u32) -> [PointConstraint; 2] {
 
 /// A point's normal target, mass scale and impulse scale (see `normal_target`), lane by
 /// lane.
-type Target<L> = (L, L, L);
+/// A point's normal target, mass scale, impulse scale and, in a biased pass, the least
+/// velocity it may keep (`sinking_floor`; −∞ in the relax pass).
+type Target<L> = (L, L, L, L);
 
 /// A batch's points, their normal impulses, and their bounce lanes where some lane may
 /// bounce.
@@ -1755,7 +1806,7 @@ fn solve_normals_alone<L: Lanes, const BIAS: bool>(
     targets: &[Target<L>],
 ) {
     for (k, (p, impulse)) in points.iter().zip(impulses).enumerate() {
-        let (target, mass_scale, impulse_scale) = targets[k];
+        let (target, mass_scale, impulse_scale, floor) = targets[k];
         let vn = pair.velocity_along(normal, p.normal_lever_a, p.normal_lever_b);
         let mut bounce = bounce.as_deref_mut().map(|b| &mut b[k]);
         if let Some(b) = bounce.as_deref_mut() {
@@ -1763,7 +1814,9 @@ fn solve_normals_alone<L: Lanes, const BIAS: bool>(
         }
         let accumulated = *impulse;
         let change = if BIAS {
-            impulse_scale.neg_mul_add(accumulated, -p.normal_mass * mass_scale * (vn - target))
+            let soft =
+                impulse_scale.neg_mul_add(accumulated, -p.normal_mass * mass_scale * (vn - target));
+            soft.max(-p.normal_mass * (vn - floor))
         } else {
             -p.normal_mass * (vn - target)
         };
@@ -1938,6 +1991,7 @@ pub(super) mod tests {
             soft: Softness::new(30.0, 10.0, 1.0 / 240.0),
             static_soft: Softness::new(60.0, 10.0, 1.0 / 240.0),
             max_push: 3.0,
+            max_depth: 0.1,
             use_bias,
         }
     }

@@ -1,0 +1,148 @@
+//! Saving under failure: the three files are saved as one (all new or all old, whatever
+//! step fails), keep their permissions and symbolic links, and a folder that cannot be
+//! synced after every file is in place does not make the next save refuse.
+
+use robosim::db::{Database, FileKind, Overwrite, SaveError, SaveStep};
+use std::path::Path;
+
+/// A copy of the default database in a fresh folder.
+fn copy_of_data() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    for kind in FileKind::ALL {
+        std::fs::copy(
+            Path::new("data").join(kind.file_name()),
+            dir.path().join(kind.file_name()),
+        )
+        .unwrap();
+    }
+    dir
+}
+
+fn contents(dir: &Path) -> Vec<Vec<u8>> {
+    FileKind::ALL
+        .iter()
+        .map(|k| std::fs::read(dir.join(k.file_name())).unwrap())
+        .collect()
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// An edit to every file, so that a save writes all three.
+fn edit_everything(db: &mut Database) {
+    db.model.bodies[0].density *= 2.0;
+    db.model.robots[0].bodies[0].placement.x += 1.0;
+    db.model.scenes[0].friction = 0.25;
+}
+
+/// Every step of a save, as a save that fails none of them takes them.
+fn steps_of_a_save() -> Vec<SaveStep> {
+    let dir = copy_of_data();
+    let (mut db, _) = Database::load(dir.path());
+    edit_everything(&mut db);
+    let mut steps = Vec::new();
+    db.save_with(dir.path(), Overwrite::Never, |step| {
+        steps.push(step);
+        Ok(())
+    })
+    .unwrap();
+    steps
+}
+
+#[test]
+fn a_save_that_fails_at_any_step_leaves_all_the_old_files_or_all_the_new() {
+    let steps = steps_of_a_save();
+    // Three temporaries, three backups, three renames, the folder.
+    assert_eq!(steps.len(), 10, "{steps:?}");
+    let new = {
+        let dir = copy_of_data();
+        let (mut db, _) = Database::load(dir.path());
+        edit_everything(&mut db);
+        db.save(Overwrite::Never).unwrap();
+        contents(dir.path())
+    };
+    for (k, failing) in steps.iter().enumerate() {
+        let dir = copy_of_data();
+        let old = contents(dir.path());
+        let (mut db, _) = Database::load(dir.path());
+        edit_everything(&mut db);
+        let mut taken = 0;
+        let result = db.save_with(dir.path(), Overwrite::Never, |step| {
+            taken += 1;
+            if taken == k + 1 {
+                assert_eq!(step, *failing);
+                Err(std::io::Error::other("the disk is full"))
+            } else {
+                Ok(())
+            }
+        });
+        let now = contents(dir.path());
+        if *failing == SaveStep::SyncFolder {
+            assert!(
+                matches!(result, Err(SaveError::NotDurable { .. })),
+                "{result:?}"
+            );
+            assert_eq!(now, new, "failing {failing:?}: every file is in place");
+            // The save did happen: the next one has nothing to refuse.
+            db.model.bodies[0].cor = 0.5;
+            db.save(Overwrite::Never).unwrap();
+        } else {
+            assert!(matches!(result, Err(SaveError::Io { .. })), "{result:?}");
+            assert_eq!(now, old, "failing {failing:?}: every old file is back");
+            // And a save that completes writes what was asked.
+            db.save(Overwrite::Never).unwrap();
+            assert_eq!(contents(dir.path()), new, "after failing {failing:?}");
+        }
+        assert_eq!(
+            names(dir.path()),
+            ["bodies.xml", "robots.xml", "scenes.xml"],
+            "failing {failing:?}: nothing left behind"
+        );
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_saved_file_keeps_its_permissions_and_its_symbolic_link() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = copy_of_data();
+    let elsewhere = tempfile::tempdir().unwrap();
+    let real_bodies = elsewhere.path().join("shared-bodies.xml");
+    std::fs::rename(dir.path().join("bodies.xml"), &real_bodies).unwrap();
+    std::os::unix::fs::symlink(&real_bodies, dir.path().join("bodies.xml")).unwrap();
+    let robots = dir.path().join("robots.xml");
+    std::fs::set_permissions(&robots, std::fs::Permissions::from_mode(0o640)).unwrap();
+    std::fs::set_permissions(&real_bodies, std::fs::Permissions::from_mode(0o664)).unwrap();
+
+    let (mut db, _) = Database::load(dir.path());
+    edit_everything(&mut db);
+    db.save(Overwrite::Never).unwrap();
+
+    let link = std::fs::symlink_metadata(dir.path().join("bodies.xml")).unwrap();
+    assert!(link.file_type().is_symlink(), "bodies.xml is still a link");
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&real_bodies), 0o664);
+    assert_eq!(mode(&robots), 0o640);
+    let (again, _) = Database::load(dir.path());
+    assert_eq!(
+        again.model, db.model,
+        "the link's target holds the saved bodies"
+    );
+    // A new file is made as the user's files are, not private to them.
+    let fresh = tempfile::tempdir().unwrap();
+    Database::new(db.model.clone())
+        .save_to(fresh.path(), Overwrite::Never)
+        .unwrap();
+    let scenes_mode = mode(&fresh.path().join("scenes.xml"));
+    assert_ne!(
+        scenes_mode & 0o044,
+        0,
+        "readable by others: {scenes_mode:o}"
+    );
+}
