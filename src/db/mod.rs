@@ -15,6 +15,7 @@ pub use xml::{MAX_DEPTH, clip};
 use crate::model::{Model, same_name};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The default database, embedded so the app runs anywhere (`data/` in the repository).
 pub const EMBEDDED: [(FileKind, &str); 3] = [
@@ -63,6 +64,9 @@ pub struct Database {
     loaded: [Loaded; 3],
     /// The model as last loaded or saved: what "unsaved changes" are measured against.
     clean: Model,
+    /// Each file's records' text as it is in the file, aligned with `clean`'s records:
+    /// a record unchanged since is saved as it was, byte for byte.
+    sources: [Vec<Option<Arc<str>>>; 3],
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -162,14 +166,17 @@ impl Database {
             let loaded = &mut db.loaded[kind.index()];
             loaded.bytes = bytes;
             let Some(bytes) = &loaded.bytes else { continue };
-            let parsed = match xml::decode(bytes, &name) {
-                Ok(decoded) => {
-                    problems.extend(decoded.warning);
-                    xml::parse(&decoded.text, &name)
+            let decoded = match xml::decode(bytes, &name) {
+                Ok(decoded) => decoded,
+                Err(p) => {
+                    problems.push(p);
+                    loaded.lossy = true;
+                    continue;
                 }
-                Err(p) => Err(vec![p]),
             };
-            let (root, syntax_skipped) = match parsed {
+            problems.extend(decoded.warning);
+            let text = decoded.text;
+            let (root, syntax_skipped) = match xml::parse(&text, &name) {
                 Ok(parsed) => {
                     problems.extend(parsed.problems);
                     (parsed.root, parsed.skipped)
@@ -180,26 +187,32 @@ impl Database {
                     continue;
                 }
             };
-            let skipped = match kind {
+            let (skipped, spans) = match kind {
                 FileKind::Bodies => {
                     let r = read::bodies(&root, &name);
                     db.model.bodies = r.records;
                     problems.extend(r.problems);
-                    r.skipped
+                    (r.skipped, r.spans)
                 }
                 FileKind::Robots => {
                     let r = read::robots(&root, &name);
                     db.model.robots = r.records;
                     problems.extend(r.problems);
-                    r.skipped
+                    (r.skipped, r.spans)
                 }
                 FileKind::Scenes => {
                     let r = read::scenes(&root, &name);
                     db.model.scenes = r.records;
                     problems.extend(r.problems);
-                    r.skipped
+                    (r.skipped, r.spans)
                 }
             };
+            let sources = spans
+                .into_iter()
+                .map(|span| span.and_then(|r| text.get(r)).map(Arc::from))
+                .collect();
+            drop(text);
+            db.sources[kind.index()] = sources;
             db.loaded[kind.index()].lossy = skipped || syntax_skipped;
         }
         db.clean = db.model.clone();
@@ -219,12 +232,52 @@ impl Database {
         check(&self.model, |kind| self.file_label(kind))
     }
 
-    /// The text each file would have if saved now.
+    /// The text each file would have if saved now: each record unchanged since it was
+    /// loaded or saved as it is in the file (its numbers as they were written), the
+    /// others written anew.
     pub fn render(&self, kind: FileKind) -> String {
+        let sources = &self.sources[kind.index()];
+        // The record's text if the record is unchanged: the clean record of that name,
+        // equal to it, with its text kept.
+        fn kept<'a, T: PartialEq>(
+            clean: &'a [T],
+            sources: &'a [Option<Arc<str>>],
+            name: impl Fn(&T) -> &str + 'a,
+        ) -> impl Fn(&T) -> Option<Arc<str>> + 'a {
+            move |record| {
+                let k = clean.iter().position(|c| name(c) == name(record))?;
+                (clean[k] == *record).then(|| sources.get(k).cloned().flatten())?
+            }
+        }
+        let clean = &self.clean;
         match kind {
-            FileKind::Bodies => write::bodies(&self.model.bodies),
-            FileKind::Robots => write::robots(&self.model.robots),
-            FileKind::Scenes => write::scenes(&self.model.scenes),
+            FileKind::Bodies => write::file(
+                "bodies",
+                &self.model.bodies,
+                kept(&clean.bodies, sources, |b| &b.name),
+                write::body,
+            ),
+            FileKind::Robots => write::file(
+                "robots",
+                &self.model.robots,
+                kept(&clean.robots, sources, |r| &r.name),
+                write::robot,
+            ),
+            FileKind::Scenes => write::file(
+                "scenes",
+                &self.model.scenes,
+                kept(&clean.scenes, sources, |s| &s.name),
+                write::scene,
+            ),
+        }
+    }
+
+    /// Whether `kind`'s collection differs from what was loaded or last saved.
+    fn collection_changed(&self, kind: FileKind) -> bool {
+        match kind {
+            FileKind::Bodies => self.model.bodies != self.clean.bodies,
+            FileKind::Robots => self.model.robots != self.clean.robots,
+            FileKind::Scenes => self.model.scenes != self.clean.scenes,
         }
     }
 
@@ -262,8 +315,16 @@ impl Database {
         overwrite: Overwrite,
         mut before: impl FnMut(SaveStep) -> std::io::Result<()>,
     ) -> Result<(), SaveError> {
-        let texts: Vec<(FileKind, String)> =
-            FileKind::ALL.iter().map(|&k| (k, self.render(k))).collect();
+        // A file is written only if its records changed, or it is not where it was loaded
+        // from (a save to another folder): the others stay as they are, byte for byte.
+        let moved = self.dir.as_deref() != Some(dir);
+        let texts: Vec<(FileKind, String)> = FileKind::ALL
+            .iter()
+            .filter(|&&k| {
+                moved || self.collection_changed(k) || self.loaded[k.index()].bytes.is_none()
+            })
+            .map(|&k| (k, self.render(k)))
+            .collect();
         // Check every file before writing any, so a refusal changes nothing.
         for (kind, text) in &texts {
             let path = dir.join(kind.file_name());
@@ -286,7 +347,7 @@ impl Database {
             source,
         })?;
         let mut changed = Vec::new();
-        for (kind, text) in texts {
+        for (kind, text) in texts.clone() {
             let path = dir.join(kind.file_name());
             let unchanged = read_file(&path).ok().as_deref() == Some(text.as_bytes());
             // A file that never existed and would be empty stays absent.
@@ -307,11 +368,12 @@ impl Database {
         };
         // Every file is renamed into place: what is on disk is what was saved, even if the
         // folder could not be synced (then say so, but do not refuse the next save).
-        for kind in FileKind::ALL {
+        for (kind, text) in &texts {
             self.loaded[kind.index()] = Loaded {
                 bytes: read_file(&dir.join(kind.file_name())).ok(),
                 lossy: false,
             };
+            self.sources[kind.index()] = record_texts(text, *kind);
         }
         self.clean = self.model.clone();
         match not_durable {
@@ -385,6 +447,20 @@ pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
         )));
     }
     Ok(bytes)
+}
+
+/// The records' texts of a file this program wrote, in order (its own writing reads back
+/// whole, one record per model record).
+fn record_texts(text: &str, kind: FileKind) -> Vec<Option<Arc<str>>> {
+    let Ok(parsed) = xml::parse(text, kind.file_name()) else {
+        return Vec::new();
+    };
+    parsed
+        .root
+        .children
+        .iter()
+        .map(|c| c.span.clone().and_then(|r| text.get(r)).map(Arc::from))
+        .collect()
 }
 
 /// One step of saving, for failure injection (`Database::save_with`).

@@ -13,6 +13,8 @@ use crate::model::{
 /// skipped (saving such a file would drop it, so the database asks first).
 pub struct Read<T> {
     pub records: Vec<T>,
+    /// Where each record's element lies in the file's text (see `xml::Element::span`).
+    pub spans: Vec<Option<std::ops::Range<usize>>>,
     pub problems: Vec<Problem>,
     pub skipped: bool,
 }
@@ -151,6 +153,7 @@ fn named(element: &Element, kind: &str) -> String {
 pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
     let mut problems = Vec::new();
     let mut records = Vec::new();
+    let mut spans = Vec::new();
     let mut skipped = false;
     for el in &root.children {
         if el.name != "body" {
@@ -195,10 +198,12 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
             skipped = true;
         } else {
             records.push(body);
+            spans.push(el.span.clone());
         }
     }
     Read {
         records,
+        spans,
         problems,
         skipped,
     }
@@ -233,6 +238,7 @@ fn placement(
 pub fn robots(root: &Element, file: &str) -> Read<Robot> {
     let mut problems = Vec::new();
     let mut records = Vec::new();
+    let mut spans = Vec::new();
     let mut skipped = false;
     for el in &root.children {
         if el.name != "robot" {
@@ -325,10 +331,12 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
             skipped = true;
         } else {
             records.push(robot);
+            spans.push(el.span.clone());
         }
     }
     Read {
         records,
+        spans,
         problems,
         skipped,
     }
@@ -337,6 +345,7 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
 pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
     let mut problems = Vec::new();
     let mut records = Vec::new();
+    let mut spans = Vec::new();
     let mut skipped = false;
     for el in &root.children {
         if el.name != "scene" {
@@ -383,10 +392,12 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
             skipped = true;
         } else {
             records.push(scene);
+            spans.push(el.span.clone());
         }
     }
     Read {
         records,
+        spans,
         problems,
         skipped,
     }

@@ -71,129 +71,152 @@ impl Tag {
 
 const HEADER: &str = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
 
-pub fn bodies(bodies: &[BodyDef]) -> String {
-    let mut out = format!("{HEADER}<bodies>\n");
-    for b in bodies {
-        let mut tag = Tag::open(2, "body")
-            .text("name", &b.name)
-            .num("density", b.density)
-            .num("cor", b.cor);
-        if let Some(mu) = b.friction {
-            tag = tag.num("friction", mu);
+/// A file of `records` under `root`: each record as `kept` gives its text (an unchanged
+/// record's, as it was in the file) or else as `render` writes it.
+pub fn file<T>(
+    root: &str,
+    records: &[T],
+    kept: impl Fn(&T) -> Option<std::sync::Arc<str>>,
+    render: impl Fn(&T, &mut String),
+) -> String {
+    let mut out = format!("{HEADER}<{root}>\n");
+    for r in records {
+        match kept(r) {
+            Some(text) => {
+                out.push_str("  ");
+                out.push_str(&text);
+                out.push('\n');
+            }
+            None => render(r, &mut out),
         }
-        tag.extra(&b.extra).start(&mut out);
-        for v in &b.vertices {
-            Tag::open(4, "vertex")
-                .num("x", v[0])
-                .num("y", v[1])
-                .empty(&mut out);
-        }
-        out.push_str("  </body>\n");
     }
-    out.push_str("</bodies>\n");
+    let _ = writeln!(out, "</{root}>");
     out
+}
+
+pub fn bodies(bodies: &[BodyDef]) -> String {
+    file("bodies", bodies, |_| None, body)
 }
 
 pub fn robots(robots: &[Robot]) -> String {
-    let mut out = format!("{HEADER}<robots>\n");
-    for r in robots {
-        Tag::open(2, "robot")
-            .text("name", &r.name)
-            .extra(&r.extra)
-            .start(&mut out);
-        for b in &r.bodies {
-            let p = &b.placement;
-            let tag = Tag::open(4, "body")
-                .text("alias", &p.alias)
-                .text("source", &p.source)
-                .num("x", p.x)
-                .num("y", p.y)
-                .num("orientation", p.orientation)
-                .extra(&p.extra);
-            if b.motors.is_empty() {
-                tag.empty(&mut out);
-                continue;
-            }
-            tag.start(&mut out);
-            for m in &b.motors {
-                Tag::open(6, "force")
-                    .num("time0", m.time0 as f64)
-                    .num("time1", m.time1 as f64)
-                    .num("angular", m.angular)
-                    .num("startTorque", m.start_torque)
-                    .num("maxTorque", m.max_torque)
-                    .num("increase", m.increase)
-                    .extra(&m.extra)
-                    .empty(&mut out);
-            }
-            out.push_str("    </body>\n");
-        }
-        for j in &r.joints {
-            let mut tag = Tag::open(4, "joint")
-                .text("bodyA", &j.body_a)
-                .text("bodyB", &j.body_b)
-                .num("anchorAx", j.anchor_ax)
-                .num("anchorAy", j.anchor_ay);
-            if j.collide {
-                tag = tag.text("collide", "true");
-            }
-            let tag = tag.extra(&j.extra);
-            match &j.motor {
-                None => tag.empty(&mut out),
-                Some(m) => {
-                    tag.start(&mut out);
-                    Tag::open(6, "motor")
-                        .num("time0", m.time0 as f64)
-                        .num("time1", m.time1 as f64)
-                        .num("angular", m.angular)
-                        .num("maxTorque", m.max_torque)
-                        .extra(&m.extra)
-                        .empty(&mut out);
-                    out.push_str("    </joint>\n");
-                }
-            }
-        }
-        out.push_str("  </robot>\n");
-    }
-    out.push_str("</robots>\n");
-    out
+    file("robots", robots, |_| None, robot)
 }
 
 pub fn scenes(scenes: &[Scene]) -> String {
-    let mut out = format!("{HEADER}<scenes>\n");
-    for s in scenes {
-        let mut tag = Tag::open(2, "scene")
-            .text("name", &s.name)
-            .num("gravitation", s.gravitation)
-            .num("friction", s.friction);
-        if let Some(h) = s.timestep {
-            tag = tag.num("timestep", h);
-        }
-        if let Some(solver) = &s.solver {
-            tag = tag.text("solver", solver);
-        }
-        tag.extra(&s.extra).start(&mut out);
-        for r in &s.robots {
-            Tag::open(4, "robot")
-                .text("source", &r.source)
-                .num("x", r.x)
-                .num("y", r.y)
-                .num("orientation", r.orientation)
-                .extra(&r.extra)
-                .empty(&mut out);
-        }
-        for b in &s.bodies {
-            Tag::open(4, "body")
-                .text("alias", &b.alias)
-                .text("source", &b.source)
-                .num("x", b.x)
-                .num("y", b.y)
-                .num("orientation", b.orientation)
-                .extra(&b.extra)
-                .empty(&mut out);
-        }
-        out.push_str("  </scene>\n");
+    file("scenes", scenes, |_| None, scene)
+}
+
+/// One `<body>` record.
+pub fn body(b: &BodyDef, out: &mut String) {
+    let mut tag = Tag::open(2, "body")
+        .text("name", &b.name)
+        .num("density", b.density)
+        .num("cor", b.cor);
+    if let Some(mu) = b.friction {
+        tag = tag.num("friction", mu);
     }
-    out.push_str("</scenes>\n");
-    out
+    tag.extra(&b.extra).start(out);
+    for v in &b.vertices {
+        Tag::open(4, "vertex")
+            .num("x", v[0])
+            .num("y", v[1])
+            .empty(out);
+    }
+    out.push_str("  </body>\n");
+}
+
+/// One `<robot>` record.
+pub fn robot(r: &Robot, out: &mut String) {
+    Tag::open(2, "robot")
+        .text("name", &r.name)
+        .extra(&r.extra)
+        .start(out);
+    for b in &r.bodies {
+        let p = &b.placement;
+        let tag = Tag::open(4, "body")
+            .text("alias", &p.alias)
+            .text("source", &p.source)
+            .num("x", p.x)
+            .num("y", p.y)
+            .num("orientation", p.orientation)
+            .extra(&p.extra);
+        if b.motors.is_empty() {
+            tag.empty(out);
+            continue;
+        }
+        tag.start(out);
+        for m in &b.motors {
+            Tag::open(6, "force")
+                .num("time0", m.time0 as f64)
+                .num("time1", m.time1 as f64)
+                .num("angular", m.angular)
+                .num("startTorque", m.start_torque)
+                .num("maxTorque", m.max_torque)
+                .num("increase", m.increase)
+                .extra(&m.extra)
+                .empty(out);
+        }
+        out.push_str("    </body>\n");
+    }
+    for j in &r.joints {
+        let mut tag = Tag::open(4, "joint")
+            .text("bodyA", &j.body_a)
+            .text("bodyB", &j.body_b)
+            .num("anchorAx", j.anchor_ax)
+            .num("anchorAy", j.anchor_ay);
+        if j.collide {
+            tag = tag.text("collide", "true");
+        }
+        let tag = tag.extra(&j.extra);
+        match &j.motor {
+            None => tag.empty(out),
+            Some(m) => {
+                tag.start(out);
+                Tag::open(6, "motor")
+                    .num("time0", m.time0 as f64)
+                    .num("time1", m.time1 as f64)
+                    .num("angular", m.angular)
+                    .num("maxTorque", m.max_torque)
+                    .extra(&m.extra)
+                    .empty(out);
+                out.push_str("    </joint>\n");
+            }
+        }
+    }
+    out.push_str("  </robot>\n");
+}
+
+/// One `<scene>` record.
+pub fn scene(s: &Scene, out: &mut String) {
+    let mut tag = Tag::open(2, "scene")
+        .text("name", &s.name)
+        .num("gravitation", s.gravitation)
+        .num("friction", s.friction);
+    if let Some(h) = s.timestep {
+        tag = tag.num("timestep", h);
+    }
+    if let Some(solver) = &s.solver {
+        tag = tag.text("solver", solver);
+    }
+    tag.extra(&s.extra).start(out);
+    for r in &s.robots {
+        Tag::open(4, "robot")
+            .text("source", &r.source)
+            .num("x", r.x)
+            .num("y", r.y)
+            .num("orientation", r.orientation)
+            .extra(&r.extra)
+            .empty(out);
+    }
+    for b in &s.bodies {
+        Tag::open(4, "body")
+            .text("alias", &b.alias)
+            .text("source", &b.source)
+            .num("x", b.x)
+            .num("y", b.y)
+            .num("orientation", b.orientation)
+            .extra(&b.extra)
+            .empty(out);
+    }
+    out.push_str("  </scene>\n");
 }

@@ -15,6 +15,9 @@ pub struct Element {
     pub attributes: Vec<(String, String)>,
     pub children: Vec<Element>,
     pub location: Location,
+    /// For a record (a child of the root): its text in the file, from its tag's `<` to
+    /// the end of its end tag, so that saving can write an unchanged record as it was.
+    pub span: Option<std::ops::Range<usize>>,
 }
 
 /// Line and column (1-based) of each byte offset of a text.
@@ -284,7 +287,10 @@ fn parse_once(
                 if starts_record(&stack) {
                     record = Some((tag_start, tag_name(&start)));
                 }
-                let done = element(&start, location, file).map_err(|p| fail(p, &record))?;
+                let mut done = element(&start, location, file).map_err(|p| fail(p, &record))?;
+                if stack.len() == 1 {
+                    done.span = Some(tag_start..reader.buffer_position() as usize);
+                }
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(done),
                     None => root = Some(done),
@@ -295,7 +301,12 @@ fn parse_once(
             }
             Event::End(_) => {
                 // quick-xml has checked that the name matches.
-                let done = stack.pop().expect("an end tag follows its start");
+                let mut done = stack.pop().expect("an end tag follows its start");
+                if stack.len() == 1
+                    && let Some((start, _)) = &record
+                {
+                    done.span = Some(*start..reader.buffer_position() as usize);
+                }
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(done),
                     None => root = Some(done),
@@ -393,6 +404,7 @@ fn element(start: &BytesStart, location: Location, file: &str) -> Result<Element
         attributes,
         children: Vec::new(),
         location,
+        span: None,
     })
 }
 
