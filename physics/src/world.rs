@@ -281,10 +281,12 @@ struct Scratch {
     /// How many times in a row the broad phase has paired the bodies again (0: it kept its
     /// pairs the last time).
     paired_in_a_row: u32,
-    /// Whether some moving body has more than `MAX_MOVING_NEIGHBOURS` moving bodies among
-    /// the broad phase's pairs, and a count per body for finding out.
+    /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among the
+    /// broad phase's pairs, each body's bounding radius, and scratch for finding out.
     crowded: bool,
-    neighbours: Vec<u32>,
+    radii: Vec<f64>,
+    grown_by: Vec<f64>,
+    neighbours: NeighbourScratch,
     /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
     fixed_now: Vec<bool>,
     solver_bodies: Vec<SolverBody>,
@@ -393,46 +395,110 @@ impl IslandNeeds {
     }
 }
 
-/// The most moving bodies a moving body collides with at once. Bodies dropped onto one
-/// spot (2,000 boxes placed at one point: two million pairs, 2.5 GB of contacts) collide
-/// with their first so many in the broad phase's order and pass through the rest until
-/// they have parted; no scene of bodies that merely touch comes near it (a box in a
-/// pyramid has eight neighbours, a disc in Box2D's jammed Confined sample six).
-const MAX_MOVING_NEIGHBOURS: u32 = 32;
+/// The most moving bodies of its own size a moving body collides with at once, the
+/// nearest first; a smaller one counts as the fraction of one that its bounding radius is
+/// of the body's, so a large body meets as many small ones as fit along it. Bodies
+/// dropped onto one spot (2,000 boxes placed at one point: two million pairs, 2.5 GB of
+/// contacts) collide with their nearest so many and pass through the rest until they
+/// have parted. No scene of bodies that merely touch comes near it (a box in a pyramid
+/// has eight neighbours); where bodies move fast among many, as the benchmark's smash's
+/// block of 0.5 m boxes struck at 40 m/s, the pairs dropped are those farthest off, which
+/// nearer ones stand between.
+const MAX_NEIGHBOURS: f64 = 32.0;
 
-/// Whether some moving body has more than `MAX_MOVING_NEIGHBOURS` moving bodies among
-/// `pairs` (counted into `neighbours`).
-fn crowded(pairs: &[(u32, u32)], fixed: &[bool], neighbours: &mut Vec<u32>) -> bool {
-    neighbours.clear();
-    neighbours.resize(fixed.len(), 0);
+/// How much of body `i`'s room for neighbours body `j` takes: 1 for a body at least its
+/// size, by bounding radius, and less for a smaller one.
+fn neighbour_share(radii: &[f64], i: usize, j: usize) -> f64 {
+    if radii[j] >= radii[i] {
+        1.0
+    } else {
+        radii[j] / radii[i]
+    }
+}
+
+/// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
+/// `pairs`, counted by `neighbour_share` into `room_taken`.
+fn crowded(pairs: &[(u32, u32)], fixed: &[bool], radii: &[f64], room_taken: &mut Vec<f64>) -> bool {
+    room_taken.clear();
+    room_taken.resize(fixed.len(), 0.0);
     let mut crowded = false;
     for &(i, j) in pairs {
-        if !fixed[i as usize] && !fixed[j as usize] {
-            for k in [i, j] {
-                neighbours[k as usize] += 1;
-                crowded |= neighbours[k as usize] > MAX_MOVING_NEIGHBOURS;
+        let (i, j) = (i as usize, j as usize);
+        if !fixed[i] && !fixed[j] {
+            for (k, other) in [(i, j), (j, i)] {
+                room_taken[k] += neighbour_share(radii, k, other);
+                crowded |= room_taken[k] > MAX_NEIGHBOURS;
             }
         }
     }
     crowded
 }
 
-/// Keeps each pair with a fixed body, and each pair of moving bodies while both have
-/// fewer than `MAX_MOVING_NEIGHBOURS` kept, in the pairs' order.
-fn keep_first_neighbours(pairs: &mut Vec<(u32, u32)>, fixed: &[bool], neighbours: &mut Vec<u32>) {
-    neighbours.clear();
-    neighbours.resize(fixed.len(), 0);
-    pairs.retain(|&(i, j)| {
+/// Scratch for `keep_nearest_neighbours`.
+#[derive(Debug, Clone, Default)]
+struct NeighbourScratch {
+    room_taken: Vec<f64>,
+    dropped: Vec<bool>,
+    /// (gap, pair) for the pairs found only by how far their bodies can move.
+    within_reach: Vec<(f64, u32)>,
+}
+
+/// Keeps each pair with a fixed body, and pairs of moving bodies while both have room
+/// (`MAX_NEIGHBOURS`): first those whose own bounds overlap, in the pairs' order (in a
+/// pile-up they are all alike and all there is), then those found only by how far the
+/// bodies can move in the step, nearest first. `boxes` are the bounds grown by `grown_by`
+/// each.
+fn keep_nearest_neighbours(
+    pairs: &mut Vec<(u32, u32)>,
+    fixed: &[bool],
+    (boxes, grown_by, radii): (&[Option<Aabb>], &[f64], &[f64]),
+    scratch: &mut NeighbourScratch,
+) {
+    let NeighbourScratch {
+        room_taken,
+        dropped,
+        within_reach,
+    } = scratch;
+    room_taken.clear();
+    room_taken.resize(fixed.len(), 0.0);
+    dropped.clear();
+    dropped.resize(pairs.len(), false);
+    within_reach.clear();
+    let mut keep_if_room = |p: usize, (i, j): (usize, usize), dropped: &mut [bool]| {
+        let (share_i, share_j) = (neighbour_share(radii, i, j), neighbour_share(radii, j, i));
+        if room_taken[i] + share_i <= MAX_NEIGHBOURS && room_taken[j] + share_j <= MAX_NEIGHBOURS {
+            room_taken[i] += share_i;
+            room_taken[j] += share_j;
+        } else {
+            dropped[p] = true;
+        }
+    };
+    for (p, &(i, j)) in pairs.iter().enumerate() {
         let (i, j) = (i as usize, j as usize);
         if fixed[i] || fixed[j] {
-            return true;
+            continue;
         }
-        let keep = neighbours[i] < MAX_MOVING_NEIGHBOURS && neighbours[j] < MAX_MOVING_NEIGHBOURS;
-        if keep {
-            neighbours[i] += 1;
-            neighbours[j] += 1;
+        let (Some(a), Some(b)) = (&boxes[i], &boxes[j]) else {
+            continue;
+        };
+        let apart = (b.min - a.max).sup(&(a.min - b.max));
+        // The gap between their own bounds, without the growth.
+        let gap = apart.x.max(apart.y) + grown_by[i] + grown_by[j];
+        if gap < 0.0 {
+            keep_if_room(p, (i, j), dropped);
+        } else {
+            within_reach.push((gap, p as u32));
         }
-        keep
+    }
+    within_reach.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    for &(_, p) in within_reach.iter() {
+        let (i, j) = pairs[p as usize];
+        keep_if_room(p as usize, (i as usize, j as usize), dropped);
+    }
+    let mut p = 0;
+    pairs.retain(|_| {
+        p += 1;
+        !dropped[p - 1]
     });
 }
 
@@ -1741,7 +1807,14 @@ impl World {
                 !both_fixed && !non_colliding.contains((i as u32, j as u32))
             };
             s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
-            s.crowded = crowded(&s.fat_pairs, fixed, &mut s.neighbours);
+            s.radii.clear();
+            s.radii.extend(
+                bodies
+                    .iter()
+                    .map(|b| b.as_ref().map_or(0.0, Body::bounding_radius)),
+            );
+            let room_taken = &mut s.neighbours.room_taken;
+            s.crowded = crowded(&s.fat_pairs, fixed, &s.radii, room_taken);
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
         let boxes = &s.boxes;
@@ -1766,7 +1839,11 @@ impl World {
             );
         }
         if s.crowded {
-            keep_first_neighbours(&mut s.pairs, &s.fat_fixed, &mut s.neighbours);
+            s.grown_by.clear();
+            s.grown_by
+                .extend(s.reach.iter().map(|reach| 0.5 * margin + reach));
+            let sizes = (&s.boxes[..], &s.grown_by[..], &s.radii[..]);
+            keep_nearest_neighbours(&mut s.pairs, &s.fat_fixed, sizes, &mut s.neighbours);
         }
     }
 
