@@ -1,6 +1,7 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
 use super::SolverBody;
+use super::envelope::EnvelopeLu;
 use super::island::{UnionFind, group_by_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
@@ -428,8 +429,9 @@ fn island_impulses(
             ))
         })
         .collect();
-    let mut k = DMatrix::<f64>::zeros(2 * m, 2 * m);
-    let mut rhs = DVector::<f64>::zeros(2 * m);
+    let n = 2 * m;
+    let mut k = vec![0.0; n * n];
+    let mut rhs = DVector::<f64>::zeros(n);
     for (p, coupled) in coupled_joints(joints, bodies).into_iter().enumerate() {
         for q in coupled {
             let block = coupling_block(
@@ -439,7 +441,7 @@ fn island_impulses(
             );
             for (r, row) in block.iter().enumerate() {
                 for (c, value) in row.iter().enumerate() {
-                    k[(2 * p + r, 2 * q + c)] = *value;
+                    k[(2 * p + r) * n + 2 * q + c] = *value;
                 }
             }
         }
@@ -449,11 +451,19 @@ fn island_impulses(
     }
     // Redundant joints (closed loops at special poses) make K singular: a regularisation
     // far below the entries' rounding keeps the solve going without changing answers.
-    let scale = (0..2 * m).map(|i| k[(i, i)]).fold(0.0, f64::max);
-    for i in 0..2 * m {
-        k[(i, i)] += 1e-12 * scale;
+    let scale = (0..n).map(|i| k[i * n + i]).fold(0.0, f64::max);
+    for i in 0..n {
+        k[i * n + i] += 1e-12 * scale;
     }
-    let psi = k.lu().solve(&rhs)?;
+    // Within K's envelope where its pivots stay well away from zero (a chain's K is block
+    // tridiagonal: 2.4 -> 1.2 ms a step for 41 pins), densely with pivoting otherwise.
+    let mut envelope = EnvelopeLu::default();
+    let psi = if envelope.factor(&k, n, 1e-10 * scale) {
+        envelope.solve(rhs.as_mut_slice());
+        rhs
+    } else {
+        DMatrix::from_row_slice(n, n, &k).lu().solve(&rhs)?
+    };
     psi.iter().all(|v| v.is_finite()).then_some(psi)
 }
 
