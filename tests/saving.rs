@@ -198,3 +198,35 @@ fn a_save_writes_only_what_changed_and_unchanged_records_as_they_were() {
     let (again, _) = Database::load(dir.path());
     assert_eq!(again.model, db.model);
 }
+
+/// A file that is there but cannot be read (here a folder named bodies.xml; also a file
+/// over the size limit, or one without permission) loads as an empty collection with an
+/// error, and a save never writes over it: an edit elsewhere saves the other files, and an
+/// edit to its own collection is refused unless the user accepts the loss.
+#[test]
+fn a_file_that_could_not_be_read_is_never_written_over() {
+    let dir = copy_of_data();
+    let bodies = dir.path().join(FileKind::Bodies.file_name());
+    std::fs::remove_file(&bodies).unwrap();
+    std::fs::create_dir(&bodies).unwrap();
+    std::fs::write(bodies.join("keep"), "the user's").unwrap();
+    let (mut db, problems) = Database::load(dir.path());
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.file.ends_with("bodies.xml") && p.message.contains("cannot read")),
+        "{problems:#?}"
+    );
+    assert!(db.model.bodies.is_empty());
+    db.model.scenes[0].friction = 0.25;
+    db.save(Overwrite::Never).unwrap();
+    assert!(bodies.join("keep").exists(), "the unreadable file was left alone");
+    assert_eq!(Database::load(dir.path()).0.model.scenes[0].friction, 0.25);
+
+    db.model.bodies.push(db.model.bodies.first().cloned().unwrap_or_default());
+    assert!(matches!(
+        db.save(Overwrite::Never),
+        Err(SaveError::WouldDropRecords(path)) if path == bodies
+    ));
+    assert!(bodies.join("keep").exists());
+}

@@ -54,6 +54,9 @@ struct Loaded {
     bytes: Option<Vec<u8>>,
     /// Some record could not be read: saving this file would drop it.
     lossy: bool,
+    /// The file is there but could not be read at all (too large, not a regular file, no
+    /// permission): it loaded as empty, and is never written over unless the user says so.
+    unreadable: bool,
 }
 
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -117,6 +120,7 @@ impl Database {
     pub fn load(dir: &Path) -> (Self, Vec<Problem>) {
         let mut files = Vec::new();
         let mut problems = Vec::new();
+        let mut unreadable = Vec::new();
         for kind in FileKind::ALL {
             let path = dir.join(kind.file_name());
             let bytes = match read_file(&path) {
@@ -128,12 +132,18 @@ impl Database {
                         "file",
                         format!("cannot read: {e}"),
                     ));
+                    unreadable.push(kind);
                     None
                 }
             };
             files.push((kind, path.display().to_string(), bytes));
         }
         let mut db = Self::from_files(files, &mut problems);
+        for kind in unreadable {
+            let loaded = &mut db.loaded[kind.index()];
+            loaded.unreadable = true;
+            loaded.lossy = true;
+        }
         db.dir = Some(dir.to_path_buf());
         problems.extend(db.check());
         (db, problems)
@@ -297,7 +307,7 @@ impl Database {
                 let path = dir.join(kind.file_name());
                 self.loaded[kind.index()] = Loaded {
                     bytes: read_file(&path).ok(),
-                    lossy: false,
+                    ..Loaded::default()
                 };
             }
         }
@@ -317,11 +327,15 @@ impl Database {
     ) -> Result<(), SaveError> {
         // A file is written only if its records changed, or it is not where it was loaded
         // from (a save to another folder): the others stay as they are, byte for byte.
+        // A file that was missing is written (the database is whole again); one that could
+        // not be read is not, unless its collection changed.
         let moved = self.dir.as_deref() != Some(dir);
         let texts: Vec<(FileKind, String)> = FileKind::ALL
             .iter()
             .filter(|&&k| {
-                moved || self.collection_changed(k) || self.loaded[k.index()].bytes.is_none()
+                let loaded = &self.loaded[k.index()];
+                let missing = loaded.bytes.is_none() && !loaded.unreadable;
+                moved || self.collection_changed(k) || missing
             })
             .map(|&k| (k, self.render(k)))
             .collect();
@@ -371,7 +385,7 @@ impl Database {
         for (kind, text) in &texts {
             self.loaded[kind.index()] = Loaded {
                 bytes: read_file(&dir.join(kind.file_name())).ok(),
-                lossy: false,
+                ..Loaded::default()
             };
             self.sources[kind.index()] = record_texts(text, *kind);
         }
