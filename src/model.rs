@@ -151,11 +151,13 @@ pub struct Scene {
     pub name: String,
     /// Gravity along +y (down on screen), in length units per s².
     pub gravitation: f64,
-    /// Coulomb μ for every contact (unless both bodies override it).
+    /// Coulomb μ of every body without a `friction` of its own; a contact mixes its two
+    /// bodies' μ by the geometric mean.
     pub friction: f64,
     /// Extension: the step h in seconds ([`DEFAULT_TIMESTEP`] when absent).
     pub timestep: Option<f64>,
-    /// Extension: the contact solver's name (`thesis`, `exact`, `soft`, `sequential`).
+    /// Extension: the contact solver's name (`auto`, the default, `exact`, `soft`, `thesis`,
+    /// `sequential`).
     pub solver: Option<String>,
     pub robots: Vec<SceneRobot>,
     pub bodies: Vec<Placement>,

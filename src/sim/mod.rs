@@ -19,7 +19,8 @@ pub enum BuildError {
 /// One simulated body and how traces name it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimBody {
-    /// The alias of a scene body, `"{source}#{i}/{alias}"` for a body of the i-th robot.
+    /// The alias of a scene body, `"{robot}#{i}/{alias}"` for a body of the i-th robot (the
+    /// robot's name as it is in robots.xml); a suffix `~2`, `~3` makes a repeated id unique.
     pub id: String,
     pub handle: BodyHandle,
     pub placed_by: PlacedBy,
@@ -37,7 +38,7 @@ pub enum PlacedBy {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimJoint {
-    /// `"{source}#{i}/{bodyA}-{bodyB}"`.
+    /// `"{robot}#{i}/{bodyA}-{bodyB}"`, unique as `SimBody::id` is.
     pub id: String,
     pub handle: JointHandle,
     /// The motor's window in steps and target in radians per step, if it has one.
