@@ -62,13 +62,15 @@ impl Timing {
 }
 
 /// Runs up to `steps` steps of `world`. Only `step` is inside the clock; `observe` sees the
-/// world after each step (with the number of steps done so far) to record the metric.
-/// Inside an `interleaved` run it hands the machine on every `TURN_STEPS` steps.
+/// world after each step (with the number of steps done so far) to record the metric. It
+/// gets the world mutably because boxdd reads a body only through a capability that
+/// borrows its world mutably; it must not change the simulation. Inside an `interleaved`
+/// run it hands the machine on every `TURN_STEPS` steps.
 pub fn measure<W>(
     world: &mut W,
     steps: usize,
     mut step: impl FnMut(&mut W),
-    mut observe: impl FnMut(&W, usize),
+    mut observe: impl FnMut(&mut W, usize),
 ) -> Timing {
     let fixed = FIXED_STEPS.load(Ordering::Relaxed);
     let (steps, budget) = if fixed > 0 {

@@ -4,15 +4,19 @@
 //! `pe <scene> [solver] [fresh]`, one scene in pe alone (for profiling), printing its
 //! outcome; with `throws [count] [seed] [list]`, the random throws alone (`throws.rs`),
 //! listing each that sinks with `list`; with `stages <scene>` (feature `stages`), pe's
-//! stages beside rapier2d's and Box2D v3's own profiles of the same scene.
+//! stages beside rapier2d's and Box2D v3's own profiles of the same scene; with `samples
+//! [name,...]`, Box2D v3's samples in every engine (`sample_runs.rs`), printing their
+//! tables.
 //!
-//! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws]` inside bench/.
+//! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws | -- samples]`
+//! inside bench/.
 
 mod box2d_scenes;
 mod harness;
 mod pe_scenes;
 mod rapier_scenes;
 mod robots;
+mod sample_runs;
 mod scene;
 mod sweep;
 mod throws;
@@ -123,7 +127,7 @@ fn main() {
         let _ = writeln!(
             md,
             "Machine: {}; load average at start: {load}; {}; {code}; whole sweep {:.0} s. \
-             rapier2d: {}; Box2D v3: {}; every engine compiled for this processor.",
+             rapier2d: {}; Box2D v3: {}; every engine's Rust compiled for this processor.",
             machine(),
             today(),
             started.elapsed().as_secs_f64(),
@@ -143,6 +147,26 @@ fn main() {
     }
     if std::env::args().nth(1).as_deref() == Some("pile") {
         run_pile_with_peers();
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("samples") {
+        let names: Vec<String> = std::env::args()
+            .skip(2)
+            .flat_map(|a| a.split(',').map(String::from).collect::<Vec<_>>())
+            .collect();
+        let rows = sample_runs::run(&names);
+        let mut md = format!(
+            "Machine: {}; load average at start: {load}; {}; {code}; rapier2d {}: {}; \
+             Box2D v3 through boxdd {}: {}.\n",
+            machine(),
+            today(),
+            rapier_version(),
+            PeerBuild::CURRENT.rapier2d(),
+            locked_version("boxdd"),
+            PeerBuild::CURRENT.box2d(),
+        );
+        sample_runs::write(&mut md, &rows);
+        println!("{md}");
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("throws") {
@@ -208,7 +232,8 @@ fn main() {
     let narrow = narrow_phase_rows();
     let robot_rows = robots::run();
     let throw_rows = throws::run(throws::THROWS, throws::SEED, false);
-    let report = report(
+    let sample_rows = sample_runs::run(&[]);
+    let mut report = report(
         &rows,
         &piles,
         &narrow,
@@ -217,6 +242,7 @@ fn main() {
         started.elapsed(),
         (&load, &code),
     );
+    sample_runs::write(&mut report, &sample_rows);
     write_doc(docs, "results.md", &report);
 }
 
@@ -397,8 +423,8 @@ fn run_stages_beside_peers() {
             pe: &[Stage::Preparing],
             rapier: |p| p.islands + p.assembly,
             rapier_names: "islands + velocity assembly",
-            box2d: |p| p.prepare_stages + p.prepare_constraints,
-            box2d_names: "prepareStages + prepareConstraints",
+            box2d: |p| p.solver_setup + p.prepare_constraints,
+            box2d_names: "solverSetup + prepareConstraints",
         },
         Row {
             name: "velocities integrated",
@@ -717,10 +743,10 @@ fn report(
         w,
         "- Engines: pe (this repository, f64) with contact solvers `{}`; rapier2d {} \
          (f32, {}, one thread), default `IntegrationParameters` except `dt`, \
-         every body with `can_sleep(false)`; Box2D v3 through boxdd {} (Box2D's C \
-         sources built by cc, f32, {}, one thread), default world settings with {} \
-         substeps, sleeping off. Every engine compiled for this processor \
-         (`target-cpu=native`, bench/.cargo/config.toml).",
+         every body with `can_sleep(false)`; Box2D v3 through boxdd {} (built by cc: \
+         {}; f32, one worker), default world settings with {} substeps, sleeping off. \
+         Every engine's Rust compiled for this processor (`target-cpu=native`, \
+         bench/.cargo/config.toml).",
         names.join("`, `"),
         rapier_version(),
         PeerBuild::CURRENT.rapier2d(),
@@ -1000,6 +1026,7 @@ fn code_version() -> String {
         "bench/src",
         "bench/Cargo.toml",
         "bench/Cargo.lock",
+        "bench/.cargo",
     ];
     let status = git(&[&["status", "--porcelain", "--"][..], &sources[..]].concat());
     let changed = match status.as_deref() {
@@ -1033,6 +1060,10 @@ fn machine() -> String {
     )
 }
 
+/// The flags cc added after boxdd's own when it compiled Box2D's C sources (`CFLAGS`, set
+/// by bench/.cargo/config.toml unless the shell sets it): the later flags win.
+const BOX2D_CFLAGS: Option<&str> = option_env!("CFLAGS");
+
 /// How the peers were built (bench/Cargo.toml, feature `fastest-peers`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum PeerBuild {
@@ -1057,11 +1088,18 @@ impl PeerBuild {
         }
     }
 
-    fn box2d(self) -> &'static str {
-        match self {
+    /// Box2D's commit, its lanes and its C flags.
+    fn box2d(self) -> String {
+        let lanes = match self {
             Self::Fastest => "`BOX2D_AVX2`: eight lanes in AVX2",
             Self::Default => "boxdd's default: four lanes in SSE2",
-        }
+        };
+        let flags = match BOX2D_CFLAGS.map(str::trim) {
+            Some(f) if !f.is_empty() => format!("C compiled with boxdd's flags and then `{f}`"),
+            _ => "C compiled with boxdd's flags (-O2, asserts in)".into(),
+        };
+        let commit = boxdd_sys::UPSTREAM_SHA.get(..7).unwrap_or("unknown");
+        format!("Box2D's sources of commit {commit}, {lanes}, {flags}")
     }
 
     /// Whether this processor runs the build: Box2D's AVX2 build would stop at its
@@ -1149,6 +1187,20 @@ mod tests {
         assert_eq!(civil_from_days(0), (1970, 1, 1));
         assert_eq!(civil_from_days(11_016), (2000, 2, 29));
         assert_eq!(civil_from_days(20_454), (2026, 1, 1));
+    }
+
+    /// results.md names the Box2D commit boxdd built and the C flags it got.
+    #[test]
+    fn the_box2d_build_names_its_commit_and_flags() {
+        let build = PeerBuild::CURRENT.box2d();
+        let commit = build
+            .strip_prefix("Box2D's sources of commit ")
+            .expect(&build);
+        assert!(
+            commit.chars().take(7).all(|c| c.is_ascii_hexdigit()),
+            "{build}"
+        );
+        assert!(build.contains("C compiled with boxdd's flags"), "{build}");
     }
 
     #[test]

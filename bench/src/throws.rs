@@ -160,66 +160,84 @@ fn run_in_rapier(throw: &Throw, stepping: &mut Duration) -> Outcome {
 }
 
 fn run_in_box2d(throw: &Throw, stepping: &mut Duration) -> Outcome {
-    use boxdd::{BodyBuilder, BodyId, BodyType, ShapeDef, SurfaceMaterial, World, WorldDef};
+    use box2d_scenes::{body_builder, read, world_with_gravity};
+    use boxdd::{Body, BodyType, MixerId, Position, ShapeDef, SurfaceMaterial};
+    let at = |p: Vec2| Position::new(p.x as f32, p.y as f32);
     let v = |p: Vec2| boxdd::Vec2::new(p.x as f32, p.y as f32);
-    let def = WorldDef::builder()
-        .gravity([0.0, GRAVITY as f32])
-        .enable_sleep(false)
-        .build();
-    let mut w = World::new(def).expect("a valid world definition");
+    // pe's y points down: gravity along +y, as in the throw.
+    let mut w = world_with_gravity(GRAVITY);
     // pe's rule for a pair's restitution, the smaller one (Box2D's own takes the larger).
-    w.set_restitution_callback(|a, b| a.coefficient.min(b.coefficient));
+    // The identity names the rule for boxdd's recordings, which this run does not make.
+    w.set_restitution_callback(
+        MixerId::from_bytes(*b"pe: the smaller restitution wins"),
+        |a, b| a.coefficient.min(b.coefficient),
+    )
+    .expect("a restitution rule");
     let shape_def = |restitution: f64, density: f64| {
         let material = SurfaceMaterial::default()
             .with_friction(FRICTION as f32)
-            .with_restitution(restitution as f32);
+            .and_then(|m| m.with_restitution(restitution as f32))
+            .expect("a valid material");
         ShapeDef::builder()
             .material(material)
             .density(density as f32)
             .build()
+            .expect("a valid shape")
     };
     for ((width, height), (x, y)) in WALLS {
-        let body = BodyBuilder::new()
-            .body_type(BodyType::Static)
-            .position(v(Vec2::new(x, y)))
-            .build();
-        let body = w.create_body_id(body);
-        let polygon = boxdd::shapes::box_polygon(0.5 * width as f32, 0.5 * height as f32);
-        w.create_polygon_shape_for(body, &shape_def(WALL_RESTITUTION, 0.0), &polygon);
+        let def = body_builder(BodyType::Static)
+            .position(at(Vec2::new(x, y)))
+            .build()
+            .expect("a valid body");
+        let polygon = boxdd::shapes::box_polygon(0.5 * width as f32, 0.5 * height as f32)
+            .expect("a valid box");
+        let body = w.create_body(def).expect("a new body");
+        w.body(body)
+            .and_then(|mut b| b.create_polygon(&shape_def(WALL_RESTITUTION, 0.0), &polygon))
+            .expect("a new shape");
     }
     let bodies: Vec<_> = throw
         .bodies
         .iter()
         .map(|b| {
-            let def = BodyBuilder::new()
-                .body_type(BodyType::Dynamic)
-                .position(v(b.at))
+            let def = body_builder(BodyType::Dynamic)
+                .position(at(b.at))
                 .angle(b.angle as f32)
                 .linear_velocity(v(b.velocity))
                 .angular_velocity(b.spin as f32)
-                .enable_sleep(false)
-                .build();
-            let body = w.create_body_id(def);
+                .build()
+                .expect("a valid body");
+            let body = w.create_body(def).expect("a new body");
             let points = b.shape.vertices().iter().map(|&p| v(p));
             let polygon =
                 boxdd::shapes::polygon_from_points(points, 0.0).expect("a regular polygon");
-            w.create_polygon_shape_for(body, &shape_def(b.restitution, DENSITY), &polygon);
+            w.body(body)
+                .and_then(|mut bb| bb.create_polygon(&shape_def(b.restitution, DENSITY), &polygon))
+                .expect("a new shape");
             body
         })
         .collect();
     let mut judge = Judge::new(throw);
-    let widen = |v: boxdd::Vec2| Vec2::new(f64::from(v.x), f64::from(v.y));
+    let widen = |x: f32, y: f32| Vec2::new(f64::from(x), f64::from(y));
     for step in 0..STEPS {
         let started = Instant::now();
-        w.step(H as f32, box2d_scenes::SUBSTEPS);
+        box2d_scenes::step(&mut w, H, box2d_scenes::SUBSTEPS);
         *stepping += started.elapsed();
-        let state = |&b: &BodyId| BodyState {
-            at: widen(w.body_position(b)),
-            angle: f64::from(w.body_rotation(b).angle()),
-            velocity: widen(w.body_linear_velocity(b)),
-            spin: f64::from(w.body_angular_velocity(b)),
-        };
-        judge.after_step(step, bodies.iter().map(state));
+        let states: Vec<BodyState> = bodies
+            .iter()
+            .map(|&b| {
+                read(&mut w, b, |body: &Body<'_>| {
+                    let (p, v) = (body.position()?, body.linear_velocity()?);
+                    Ok(BodyState {
+                        at: widen(p.x, p.y),
+                        angle: f64::from(body.rotation()?.angle()),
+                        velocity: widen(v.x, v.y),
+                        spin: f64::from(body.angular_velocity()?),
+                    })
+                })
+            })
+            .collect();
+        judge.after_step(step, states.into_iter());
     }
     judge.outcome()
 }
