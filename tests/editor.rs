@@ -32,9 +32,11 @@ fn harness(dir: &Path) -> Harness<'static, RoboSimApp> {
 /// Clicks the canvas at world point (x, y).
 fn click_world(h: &mut Harness<'_, RoboSimApp>, x: f64, y: f64, modifiers: Modifiers) {
     let app = h.state();
-    let pos: Pos2 = app.camera.to_screen(app.canvas_rect, pe::Vec2::new(x, y));
+    let pos: Pos2 = app
+        .camera()
+        .to_screen(app.canvas_rect(), pe::Vec2::new(x, y));
     assert!(
-        app.canvas_rect.contains(pos),
+        app.canvas_rect().contains(pos),
         "({x}, {y}) is off the canvas"
     );
     h.event(Event::ModifiersChanged(modifiers));
@@ -56,8 +58,16 @@ fn click_world(h: &mut Harness<'_, RoboSimApp>, x: f64, y: f64, modifiers: Modif
 /// Drags on the canvas with the primary button from world point `from` to `to`.
 fn drag_world(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64)) {
     let app = h.state();
-    let screen = |(x, y): (f64, f64)| app.camera.to_screen(app.canvas_rect, pe::Vec2::new(x, y));
+    let screen = |(x, y): (f64, f64)| {
+        app.camera()
+            .to_screen(app.canvas_rect(), pe::Vec2::new(x, y))
+    };
     let (start, end) = (screen(from), screen(to));
+    drag_screen(h, start, end, 4);
+}
+
+/// Drags with the primary button from screen point `start` to `end` in `moves` frames.
+fn drag_screen(h: &mut Harness<'_, RoboSimApp>, start: Pos2, end: Pos2, moves: usize) {
     h.event(Event::PointerMoved(start));
     h.run_steps(1);
     let button = |pos, pressed| Event::PointerButton {
@@ -68,9 +78,9 @@ fn drag_world(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64))
     };
     h.event(button(start, true));
     h.run_steps(1);
-    for k in 1..=4 {
+    for k in 1..=moves {
         h.event(Event::PointerMoved(
-            start + (end - start) * (k as f32 / 4.0),
+            start + (end - start) * (k as f32 / moves as f32),
         ));
         h.run_steps(1);
     }
@@ -105,26 +115,26 @@ fn a_body_drawn_by_clicks_is_saved_and_found_again() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
     new_item(&mut h, "body");
-    let name = match &h.state().selection {
+    let name = match h.state().selection() {
         Some(Selection::Body(name)) => name.clone(),
         other => panic!("a new body is selected, not {other:?}"),
     };
     click(&mut h, "Clear and draw");
-    assert!(h.state().db.model.body(&name).unwrap().vertices.is_empty());
+    assert!(h.state().model().body(&name).unwrap().vertices.is_empty());
     for (x, y) in [(-15.0, -10.0), (15.0, -10.0), (15.0, 10.0), (-15.0, 10.0)] {
         click_world(&mut h, x, y, Modifiers::NONE);
     }
-    let body = h.state().db.model.body(&name).unwrap().clone();
+    let body = h.state().model().body(&name).unwrap().clone();
     assert_eq!(
         body.vertices,
         vec![[-15.0, -10.0], [15.0, -10.0], [15.0, 10.0], [-15.0, 10.0]]
     );
     type_into(&mut h, "density", "2.5");
-    assert_eq!(h.state().db.model.body(&name).unwrap().density, 2.5);
+    assert_eq!(h.state().model().body(&name).unwrap().density, 2.5);
 
     h.key_press_modifiers(Modifiers::COMMAND, Key::S);
     h.run_steps(2);
-    assert!(!h.state().db.is_dirty(), "saved: {}", h.state().status);
+    assert!(!h.state().db().is_dirty(), "saved: {}", h.state().status());
     let (reloaded, problems) = Database::load(dir.path());
     assert!(problems.iter().all(|p| !p.is_error()), "{problems:#?}");
     let saved = reloaded
@@ -143,36 +153,36 @@ fn a_click_that_would_dent_the_body_is_refused_with_a_message() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
     new_item(&mut h, "body");
-    let Some(Selection::Body(name)) = h.state().selection.clone() else {
+    let Some(Selection::Body(name)) = h.state().selection().cloned() else {
         panic!()
     };
     click(&mut h, "Clear and draw");
     for (x, y) in [(-20.0, -20.0), (20.0, -20.0), (0.0, 20.0)] {
         click_world(&mut h, x, y, Modifiers::NONE);
     }
-    let triangle = h.state().db.model.body(&name).unwrap().vertices.clone();
+    let triangle = h.state().model().body(&name).unwrap().vertices.clone();
     assert_eq!(triangle.len(), 3);
     // Inside the triangle: no edge can take it and stay convex.
     click_world(&mut h, 0.0, -5.0, Modifiers::NONE);
-    assert_eq!(h.state().db.model.body(&name).unwrap().vertices, triangle);
+    assert_eq!(h.state().model().body(&name).unwrap().vertices, triangle);
     assert!(
-        h.state().status.contains("non-convex"),
+        h.state().status().contains("non-convex"),
         "status: {}",
-        h.state().status
+        h.state().status()
     );
     h.get_by_label_contains("non-convex");
     // Shift+click takes it anyway; the outline is then flagged invalid until repaired.
     click_world(&mut h, 0.0, -5.0, Modifiers::SHIFT);
-    assert_eq!(h.state().db.model.body(&name).unwrap().vertices.len(), 4);
+    assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 4);
     assert!(
         h.state()
-            .problems
+            .problems()
             .iter()
             .any(|p| p.is_error() && p.to_string().contains(&name))
     );
     click(&mut h, "Convex hull");
-    assert_eq!(h.state().db.model.body(&name).unwrap().vertices.len(), 3);
-    assert!(!h.state().problems.iter().any(|p| p.is_error()));
+    assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 3);
+    assert!(!h.state().problems().iter().any(|p| p.is_error()));
 }
 
 #[test]
@@ -180,14 +190,14 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
     new_item(&mut h, "robot");
-    let Some(Selection::Robot(name)) = h.state().selection.clone() else {
+    let Some(Selection::Robot(name)) = h.state().selection().cloned() else {
         panic!()
     };
     for _ in 0..2 {
         click(&mut h, "+ body");
         click(&mut h, "obdelnik");
     }
-    let robot = h.state().db.model.robot(&name).unwrap().clone();
+    let robot = h.state().model().robot(&name).unwrap().clone();
     assert_eq!(robot.bodies.len(), 2);
     // obdelnik is 40 wide: the second body sits 30 to the right, overlapping by 10.
     assert_eq!(
@@ -196,7 +206,7 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     );
     assert!(
         h.state()
-            .problems
+            .problems()
             .iter()
             .any(|p| p.to_string().contains("connected")),
         "two loose bodies are flagged live"
@@ -205,13 +215,13 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     click(&mut h, "Add joint");
     click_world(&mut h, 5.0, 30.0, Modifiers::NONE); // outside both
     assert!(
-        h.state().status.contains("covered by 0"),
+        h.state().status().contains("covered by 0"),
         "{}",
-        h.state().status
+        h.state().status()
     );
     click_world(&mut h, 15.0, 0.0, Modifiers::NONE);
-    let robot = h.state().db.model.robot(&name).unwrap().clone();
-    assert_eq!(robot.joints.len(), 1, "{}", h.state().status);
+    let robot = h.state().model().robot(&name).unwrap().clone();
+    assert_eq!(robot.joints.len(), 1, "{}", h.state().status());
     let j = &robot.joints[0];
     assert_eq!(
         (j.body_a.as_str(), j.body_b.as_str()),
@@ -220,7 +230,7 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     assert_eq!((j.anchor_ax, j.anchor_ay), (15.0, 0.0));
     assert!(
         !h.state()
-            .problems
+            .problems()
             .iter()
             .any(|p| p.to_string().contains("connected"))
     );
@@ -229,7 +239,7 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     h.get_by_label_contains("obdelnik – obdelnik 2").click();
     h.run_steps(2);
     click(&mut h, "joint motor");
-    let motor = h.state().db.model.robot(&name).unwrap().joints[0]
+    let motor = h.state().model().robot(&name).unwrap().joints[0]
         .motor
         .clone();
     let motor = motor.expect("the joint has a motor");
@@ -238,7 +248,7 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
     // Run the robot preview: the motor turns body A against body B about the pin.
     click(&mut h, "Play");
     h.run_steps(30);
-    let sim = h.state().sim.as_ref().unwrap();
+    let sim = h.state().sim().unwrap();
     assert!(sim.step_count() >= 20, "steps: {}", sim.step_count());
     let m = sim.metrics();
     assert!(
@@ -266,59 +276,58 @@ fn a_scene_runs_and_its_step_counter_advances_with_play_pause_step_and_reset() {
     let mut h = harness(dir.path());
     h.get_by_label("stack of boxes").click();
     h.run_steps(10);
-    let steps = h.state().sim.as_ref().unwrap().step_count();
+    let steps = h.state().sim().unwrap().step_count();
     assert!(steps >= 5, "a selected scene plays: {steps}");
     h.key_press(Key::Space); // pause
     h.run_steps(1);
-    let paused = h.state().sim.as_ref().unwrap().step_count();
+    let paused = h.state().sim().unwrap().step_count();
     h.run_steps(10);
-    assert_eq!(h.state().sim.as_ref().unwrap().step_count(), paused);
+    assert_eq!(h.state().sim().unwrap().step_count(), paused);
     click(&mut h, "Step");
-    assert_eq!(h.state().sim.as_ref().unwrap().step_count(), paused + 1);
+    assert_eq!(h.state().sim().unwrap().step_count(), paused + 1);
     h.get_by_label_contains(&format!("step {}", paused + 1));
     click(&mut h, "Reset");
-    assert_eq!(h.state().sim.as_ref().unwrap().step_count(), 0);
+    assert_eq!(h.state().sim().unwrap().step_count(), 0);
 }
 
 #[test]
 fn undo_and_redo_round_trip_inspector_and_canvas_edits() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    let original = h.state().db.model.clone();
+    let original = h.state().model().clone();
     h.get_by_label("stack of boxes").click();
     h.run_steps(2);
     type_into(&mut h, "gravitation", "50");
     assert_eq!(
         h.state()
-            .db
-            .model
+            .model()
             .scene("stack of boxes")
             .unwrap()
             .gravitation,
         50.0
     );
-    let edited = h.state().db.model.clone();
+    let edited = h.state().model().clone();
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run_steps(2);
-    assert_eq!(h.state().db.model, original);
+    assert_eq!(*h.state().model(), original);
     h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
     h.run_steps(2);
-    assert_eq!(h.state().db.model, edited);
+    assert_eq!(*h.state().model(), edited);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run_steps(2);
     h.key_press_modifiers(Modifiers::COMMAND, Key::Y);
     h.run_steps(2);
-    assert_eq!(h.state().db.model, edited);
+    assert_eq!(*h.state().model(), edited);
 
     // Deleting a body that robots use is refused; a new, unused one goes and comes back.
     new_item(&mut h, "body");
-    let with_body = h.state().db.model.clone();
+    let with_body = h.state().model().clone();
     click(&mut h, "Delete");
-    assert_eq!(h.state().db.model.bodies.len(), with_body.bodies.len() - 1);
+    assert_eq!(h.state().model().bodies.len(), with_body.bodies.len() - 1);
     click(&mut h, "Undo");
-    assert_eq!(h.state().db.model, with_body);
+    assert_eq!(*h.state().model(), with_body);
     click(&mut h, "Redo");
-    assert_eq!(h.state().db.model.bodies.len(), with_body.bodies.len() - 1);
+    assert_eq!(h.state().model().bodies.len(), with_body.bodies.len() - 1);
 }
 
 #[test]
@@ -330,7 +339,7 @@ fn dragging_and_turning_a_body_at_step_0_edits_its_placement_in_the_scene() {
     click(&mut h, "Pause");
     click(&mut h, "Reset");
     let placement = |h: &Harness<'_, RoboSimApp>| {
-        let scene = h.state().db.model.scene("stack of boxes").unwrap().clone();
+        let scene = h.state().model().scene("stack of boxes").unwrap().clone();
         let b = scene
             .bodies
             .iter()
@@ -348,7 +357,7 @@ fn dragging_and_turning_a_body_at_step_0_edits_its_placement_in_the_scene() {
         (x, y, o),
         (460.0, 365.0, 0.0),
         "status: {}",
-        h.state().status
+        h.state().status()
     );
     h.key_press(Key::E);
     h.run_steps(2);
@@ -360,4 +369,571 @@ fn dragging_and_turning_a_body_at_step_0_edits_its_placement_in_the_scene() {
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
     h.run_steps(2);
     assert_eq!(placement(&h), (400.0, 365.0, 0.0));
+}
+
+/// Pauses the selected scene at step 0, where the canvas edits it.
+fn stop_at_step_0(h: &mut Harness<'_, RoboSimApp>) {
+    if h.state().is_running() {
+        click(h, "Pause");
+    }
+    click(h, "Reset");
+    assert_eq!(h.state().sim().unwrap().step_count(), 0);
+}
+
+#[test]
+fn ctrl_s_saves_without_stepping_the_simulation() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    type_into(&mut h, "gravitation", "150");
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_steps(2);
+    assert!(!h.state().db().is_dirty(), "saved: {}", h.state().status());
+    assert_eq!(
+        h.state().sim().unwrap().step_count(),
+        0,
+        "saving leaves the scene at step 0, where it is edited"
+    );
+    // S alone still steps.
+    h.key_press(Key::S);
+    h.run_steps(2);
+    assert_eq!(h.state().sim().unwrap().step_count(), 1);
+}
+
+/// Where simulated body `id_part` (a part of its trace id) has its reference point now.
+fn body_origin(h: &Harness<'_, RoboSimApp>, id_part: &str) -> pe::Vec2 {
+    let sim = h.state().sim().expect("a simulation");
+    let b = sim
+        .bodies
+        .iter()
+        .find(|b| b.id.contains(id_part))
+        .unwrap_or_else(|| panic!("no body {id_part}"));
+    sim.world.body(b.handle).unwrap().origin()
+}
+
+fn on_canvas(h: &Harness<'_, RoboSimApp>, p: pe::Vec2) -> bool {
+    let app = h.state();
+    app.canvas_rect()
+        .contains(app.camera().to_screen(app.canvas_rect(), p))
+}
+
+#[test]
+fn new_placements_land_in_free_space_in_view_and_a_drag_takes_the_body_on_top() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "scene");
+    let Some(Selection::Scene(scene)) = h.state().selection().cloned() else {
+        panic!()
+    };
+    click(&mut h, "+ body");
+    click(&mut h, "floor");
+    click(&mut h, "+ robot");
+    click(&mut h, "car");
+    h.run_steps(2);
+    assert!(
+        h.state().overlaps().is_empty(),
+        "the car lands clear of the floor: {:?}",
+        h.state().model().scene(&scene)
+    );
+    let chassis = body_origin(&h, "chassis");
+    assert!(on_canvas(&h, chassis), "the car is in view at {chassis}");
+    let floor = body_origin(&h, "floor");
+    assert!(chassis.y < floor.y, "above the floor, not under it");
+
+    // Dragged into the floor, the car is flagged; a second drag takes the car (drawn on
+    // top, and selected), not the floor under it.
+    drag_world(&mut h, (chassis.x, chassis.y), (floor.x, floor.y));
+    assert!(!h.state().overlaps().is_empty(), "{}", h.state().status());
+    h.get_by_label_contains("overlaps");
+    let placed = |h: &Harness<'_, RoboSimApp>| {
+        let s = h.state().model().scene(&scene).unwrap().clone();
+        (
+            (s.robots[0].x, s.robots[0].y),
+            (s.bodies[0].x, s.bodies[0].y),
+        )
+    };
+    let (_, floor_before) = placed(&h);
+    let at = body_origin(&h, "chassis");
+    drag_world(&mut h, (at.x, at.y), (at.x + 40.0, at.y - 200.0));
+    let (car, floor_after) = placed(&h);
+    assert_eq!(floor_after, floor_before, "the floor stays");
+    assert!(car.1 < floor.y - 100.0, "the car moved up: {car:?}");
+    assert!(h.state().overlaps().is_empty());
+}
+
+#[test]
+fn the_default_scenes_have_no_overlaps_to_warn_about() {
+    let (db, _) = Database::embedded();
+    for scene in &db.model.scenes {
+        let Ok(sim) = robosim::sim::Simulation::new(&db.model, &scene.name, None, None) else {
+            continue;
+        };
+        let pairs = robosim::app::placing::overlapping_pairs(&sim);
+        let named: Vec<(&str, &str)> = pairs
+            .iter()
+            .map(|&(a, b)| (sim.bodies[a].id.as_str(), sim.bodies[b].id.as_str()))
+            .collect();
+        assert!(named.is_empty(), "{}: {named:?}", scene.name);
+    }
+}
+
+#[test]
+fn a_vertex_drag_takes_the_vertex_where_the_button_went_down() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "body");
+    let Some(Selection::Body(name)) = h.state().selection().cloned() else {
+        panic!()
+    };
+    assert_eq!(
+        h.state().model().body(&name).unwrap().vertices[1],
+        [20.0, -10.0]
+    );
+    // Pressed 3 px off the vertex and moved briskly: by the time egui calls it a drag
+    // the pointer is far from every vertex.
+    let screen = |h: &Harness<'_, RoboSimApp>, x: f64, y: f64| {
+        let app = h.state();
+        app.camera()
+            .to_screen(app.canvas_rect(), pe::Vec2::new(x, y))
+            + egui::vec2(3.0, 3.0)
+    };
+    let (start, end) = (screen(&h, 20.0, -10.0), screen(&h, 30.0, -20.0));
+    drag_screen(&mut h, start, end, 2);
+    let vertices = h.state().model().body(&name).unwrap().vertices.clone();
+    assert_eq!(vertices[1], [30.0, -20.0], "{}", h.state().status());
+}
+
+fn harness_with_autosave(dir: &Path, autosave: &Path) -> Harness<'static, RoboSimApp> {
+    let app = RoboSimApp::new(Some(dir.to_path_buf())).with_autosave(Some(autosave.to_path_buf()));
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_| app);
+    h.run_steps(3);
+    h
+}
+
+#[test]
+fn unsaved_work_is_kept_soon_after_an_edit_and_offered_back_only_for_its_folder() {
+    let (folder_a, folder_b) = (scratch_db(), scratch_db());
+    let autosave = tempfile::tempdir().unwrap();
+    {
+        let mut h = harness_with_autosave(folder_a.path(), autosave.path());
+        h.get_by_label("stack of boxes").click();
+        h.run_steps(2);
+        type_into(&mut h, "gravitation", "123");
+        // The app sits idle for three seconds; then it is killed (no exit hook runs).
+        h.run_steps(180);
+    }
+    let h = harness_with_autosave(folder_b.path(), autosave.path());
+    assert!(
+        h.query_by_label_contains("Restore it?").is_none(),
+        "work on another folder is not offered here"
+    );
+    let mut h = harness_with_autosave(folder_a.path(), autosave.path());
+    h.get_by_label_contains("Restore it?");
+    click(&mut h, "Restore");
+    let g = h
+        .state()
+        .model()
+        .scene("stack of boxes")
+        .unwrap()
+        .gravitation;
+    assert_eq!(g, 123.0, "the edit made before the kill is back");
+}
+
+#[test]
+fn the_view_comes_back_with_fit_and_reset_and_the_car_demo_stops_at_the_edge_of_the_world() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("car on terrain").click();
+    h.run_steps(3);
+    // Panned far away, F brings the car back; so does Reset.
+    for key in [Key::F, Key::R] {
+        h.state_mut().camera_mut().centre += pe::Vec2::new(5e4, 5e4);
+        h.run_steps(1);
+        assert!(!on_canvas(&h, body_origin(&h, "chassis")));
+        h.key_press(key);
+        h.run_steps(2);
+        assert!(
+            on_canvas(&h, body_origin(&h, "chassis")),
+            "{key:?} fits the view"
+        );
+    }
+    // The car drives off the end of its terrain after about 17 s. Run 60 s at 8×.
+    assert!(h.state().is_running());
+    h.state_mut().set_speed(8.0);
+    for _ in 0..600 {
+        h.run_steps(1);
+        if h.state().sim().unwrap().time() > 60.0 || !h.state().is_running() {
+            break;
+        }
+    }
+    let app = h.state();
+    let sim = app.sim().unwrap();
+    let m = sim.metrics();
+    assert!(m.time > 17.0, "{m:?}");
+    assert!(m.kinetic < 1e-6, "everything stopped: {m:?}");
+    let bound = app.world_bound().unwrap();
+    for (_, b) in sim.world.bodies() {
+        let c = b.centroid();
+        assert!(c.y <= bound.limit.max.y + 1.0, "stopped at the edge: {c}");
+    }
+    assert!(app.status().contains("left the scene"), "{}", app.status());
+    assert!(!app.is_running(), "paused once nothing moves");
+    h.run_steps(3);
+    assert!(
+        on_canvas(&h, body_origin(&h, "floor")),
+        "the scene is back in view"
+    );
+}
+
+#[test]
+fn plots_show_one_unit_per_axis_with_readable_numbers_and_export_to_csv() {
+    use robosim::app::files::{Answer, Scripted};
+    use robosim::app::plots::number_at_step;
+    // Tick numbers keep the digits their spacing needs, in scientific notation when large.
+    assert_eq!(number_at_step(2.5e7, 5e6), "2.5e7");
+    assert_eq!(number_at_step(0.25, 0.05), "0.25");
+    assert_eq!(number_at_step(3e-9, 1e-9), "3e-9");
+    assert_eq!(number_at_step(1200.0, 100.0), "1200");
+
+    let dir = scratch_db();
+    let csv = dir.path().join("exported.csv");
+    let app = RoboSimApp::new(Some(dir.path().to_path_buf()))
+        .with_file_chooser(Box::new(Scripted::new([Answer::Chosen(csv.clone())])));
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_| app);
+    h.run_steps(3);
+    h.get_by_label("car on terrain").click();
+    h.run_steps(2);
+    let chassis = body_origin(&h, "chassis");
+    click_world(&mut h, chassis.x, chassis.y, Modifiers::NONE);
+    h.run_steps(20);
+    // The body plot shows one quantity, in its unit, chosen from a list.
+    h.get_by_value("position x, y (px)").click();
+    h.run_steps(2);
+    h.get_by_label("angular velocity ω (rad/s)").click();
+    h.run_steps(2);
+    h.get_by_value("angular velocity ω (rad/s)");
+    h.get_by_value("motor torques (mass·px²/s²)");
+
+    click(&mut h, "Pause");
+    click(&mut h, "Export CSV…");
+    let text = std::fs::read_to_string(&csv).expect("the CSV was written");
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("time (s),kinetic energy"), "{header}");
+    assert!(header.contains("body ω (rad/s)") && header.contains("torque car#0/"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), h.state().plot_data().samples.len());
+    assert!(rows.len() > 10);
+    let columns = header.split(',').count();
+    for row in &rows {
+        assert_eq!(row.split(',').count(), columns, "{row}");
+        row.split(',').next().unwrap().parse::<f64>().unwrap();
+    }
+    assert!(
+        h.state().status().contains("plots written"),
+        "{}",
+        h.state().status()
+    );
+}
+
+#[test]
+fn saving_a_non_convex_body_asks_first_and_says_what_the_simulation_will_do() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "body");
+    let Some(Selection::Body(name)) = h.state().selection().cloned() else {
+        panic!()
+    };
+    // A dent: Shift+click takes a vertex inside the outline.
+    click_world(&mut h, 0.0, -5.0, Modifiers::SHIFT);
+    assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 5);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_steps(2);
+    assert!(
+        h.state().db().is_dirty(),
+        "not saved before the user answers"
+    );
+    h.get_by_label_contains("not a convex polygon");
+    h.get_by_label_contains("will not run");
+    click(&mut h, "Cancel");
+    assert!(h.state().db().is_dirty());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_steps(2);
+    click(&mut h, "Save anyway");
+    assert!(!h.state().db().is_dirty(), "{}", h.state().status());
+    let (saved, _) = Database::load(dir.path());
+    assert_eq!(saved.model.body(&name).unwrap().vertices.len(), 5);
+}
+
+#[test]
+fn a_db_folder_that_does_not_exist_is_asked_about_not_opened_silently() {
+    let parent = tempfile::tempdir().unwrap();
+    let missing = parent.path().join("no such folder");
+    let mut h = harness(&missing);
+    h.get_by_label_contains("does not exist");
+    click(&mut h, "Open the examples instead");
+    assert!(h.state().db().dir.is_none());
+    assert!(!h.state().model().scenes.is_empty(), "the examples");
+    assert!(!missing.exists(), "nothing was created");
+
+    let mut h = harness(&missing);
+    click(&mut h, "Start a new database there");
+    assert_eq!(h.state().db().dir.as_deref(), Some(missing.as_path()));
+    assert!(h.state().model().bodies.is_empty());
+}
+
+#[test]
+fn open_without_a_file_dialog_says_so_and_offers_the_path_field() {
+    use robosim::app::files::{Answer, Scripted};
+    let dir = scratch_db();
+    let app = RoboSimApp::new(Some(dir.path().to_path_buf()))
+        .with_file_chooser(Box::new(Scripted::new([Answer::Unavailable])));
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_| app);
+    h.run_steps(3);
+    click(&mut h, "Open…");
+    h.run_steps(2);
+    assert!(
+        h.state().status().contains("type the folder"),
+        "{}",
+        h.state().status()
+    );
+    assert!(h.get_by_label("folder").is_focused());
+}
+
+#[test]
+fn a_refused_rename_shows_the_current_name_again() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    type_into(&mut h, "name", "car on terrain");
+    assert!(
+        h.state().status().contains("cannot rename"),
+        "{}",
+        h.state().status()
+    );
+    h.run_steps(2);
+    assert_eq!(
+        h.get_by_label("name").value().as_deref(),
+        Some("stack of boxes"),
+        "the field shows the name the scene still has"
+    );
+}
+
+#[test]
+fn a_record_that_could_not_be_read_stays_in_the_problems_after_an_unrelated_edit() {
+    let dir = scratch_db();
+    let bodies = dir.path().join("bodies.xml");
+    let text = std::fs::read_to_string(&bodies).unwrap().replace(
+        r#"<body name="wheel" density="1""#,
+        r#"<body name="wheel" density="heavy""#,
+    );
+    std::fs::write(&bodies, text).unwrap();
+    let mut h = harness(dir.path());
+    let cause = |h: &Harness<'_, RoboSimApp>| {
+        h.state()
+            .problems()
+            .iter()
+            .any(|p| p.to_string().contains("heavy"))
+    };
+    assert!(cause(&h), "{:#?}", h.state().problems());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    type_into(&mut h, "gravitation", "150");
+    assert!(
+        cause(&h),
+        "the root cause stays: {:#?}",
+        h.state().problems()
+    );
+}
+
+fn new_body(h: &mut Harness<'_, RoboSimApp>, name: &str) {
+    new_item(h, "body");
+    type_into(h, "name", name);
+    assert!(
+        h.state().model().body(name).is_some(),
+        "{}",
+        h.state().status()
+    );
+}
+
+#[test]
+fn a_new_user_builds_a_two_wheeled_robot_from_nothing_runs_it_saves_and_finds_it_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    assert!(
+        h.state().model().bodies.is_empty(),
+        "an empty folder, an empty database"
+    );
+
+    // A chassis drawn by clicks, a hexagonal wheel and a static floor from the shape tools.
+    new_body(&mut h, "chassis");
+    click(&mut h, "Clear and draw");
+    for (x, y) in [(-40.0, -10.0), (40.0, -10.0), (40.0, 10.0), (-40.0, 10.0)] {
+        click_world(&mut h, x, y, Modifiers::NONE);
+    }
+    new_body(&mut h, "wheel");
+    type_into(&mut h, "r", "18");
+    click(&mut h, "Regular polygon");
+    new_body(&mut h, "floor");
+    type_into(&mut h, "w", "1200");
+    type_into(&mut h, "h", "20");
+    click(&mut h, "Rectangle");
+    type_into(&mut h, "density", "0");
+    let m = h.state().model().clone();
+    assert_eq!(m.body("chassis").unwrap().vertices.len(), 4);
+    assert_eq!(m.body("wheel").unwrap().vertices.len(), 6);
+    assert_eq!(m.body("floor").unwrap().vertices[2], [600.0, 10.0]);
+    assert_eq!(m.body("floor").unwrap().density, 0.0);
+
+    // The robot: the chassis, two wheels dragged under its ends, two pins with motors.
+    new_item(&mut h, "robot");
+    type_into(&mut h, "name", "rover");
+    for body in ["chassis", "wheel", "wheel"] {
+        click(&mut h, "+ body");
+        click(&mut h, body);
+    }
+    let placed = |h: &Harness<'_, RoboSimApp>, k: usize| {
+        let b = &h.state().model().robot("rover").unwrap().bodies[k].placement;
+        (b.x, b.y)
+    };
+    let (x2, y2) = placed(&h, 2);
+    drag_world(&mut h, (x2, y2), (30.0, 5.0));
+    let (x1, y1) = placed(&h, 1);
+    drag_world(&mut h, (x1, y1), (-30.0, 5.0));
+    assert_eq!((placed(&h, 1), placed(&h, 2)), ((-30.0, 5.0), (30.0, 5.0)));
+    click(&mut h, "Add joint");
+    click_world(&mut h, -30.0, 5.0, Modifiers::NONE);
+    click_world(&mut h, 30.0, 5.0, Modifiers::NONE);
+    click(&mut h, "Add joint");
+    let robot = h.state().model().robot("rover").unwrap().clone();
+    assert_eq!(robot.joints.len(), 2, "{}", h.state().status());
+    for header in ["chassis – wheel", "chassis – wheel 2"] {
+        h.get_by_label(header).click();
+        h.run_steps(2);
+    }
+    for k in 0..2 {
+        h.get_all_by_label("joint motor").nth(k).unwrap().click();
+        h.run_steps(2);
+    }
+    let robot = h.state().model().robot("rover").unwrap().clone();
+    assert!(robot.joints.iter().all(|j| j.motor.is_some()), "{robot:#?}");
+
+    // The scene: the floor, the rover dropped over it.
+    new_item(&mut h, "scene");
+    type_into(&mut h, "name", "proving ground");
+    click(&mut h, "+ body");
+    click(&mut h, "floor");
+    click(&mut h, "+ robot");
+    click(&mut h, "rover");
+    assert!(h.state().overlaps().is_empty());
+    let start = body_origin(&h, "rover#0/chassis");
+    click(&mut h, "Play");
+    for _ in 0..600 {
+        h.run_steps(1);
+        if (body_origin(&h, "rover#0/chassis").x - start.x).abs() > 40.0 {
+            break;
+        }
+    }
+    let moved = body_origin(&h, "rover#0/chassis") - start;
+    assert!(moved.x.abs() > 40.0, "the rover drove: {moved}");
+    assert!(
+        h.state().sim().unwrap().metrics().max_joint_gap < 0.5,
+        "its pins hold"
+    );
+
+    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
+    h.run_steps(2);
+    assert!(!h.state().db().is_dirty(), "saved: {}", h.state().status());
+    let built = h.state().model().clone();
+    let (reloaded, problems) = Database::load(dir.path());
+    assert!(problems.is_empty(), "{problems:#?}");
+    assert_eq!(
+        reloaded.model, built,
+        "everything comes back as it was built"
+    );
+    let h = harness(dir.path());
+    assert_eq!(*h.state().model(), built);
+    assert_eq!(
+        h.state().selection(),
+        Some(&Selection::Scene("proving ground".into()))
+    );
+}
+
+#[test]
+fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() {
+    use robosim::app::files::{Answer, Scripted};
+    let dir = scratch_db();
+    let svg = dir.path().join("view.svg");
+    let app = RoboSimApp::new(Some(dir.path().to_path_buf()))
+        .with_file_chooser(Box::new(Scripted::new([Answer::Chosen(svg.clone())])));
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_| app);
+    h.run_steps(3);
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    let scene =
+        |h: &Harness<'_, RoboSimApp>| h.state().model().scene("stack of boxes").unwrap().clone();
+    let count = scene(&h).bodies.len();
+    click_world(&mut h, 400.0, 365.0, Modifiers::NONE);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::C);
+    h.run_steps(1);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run_steps(2);
+    let pasted = scene(&h);
+    assert_eq!(pasted.bodies.len(), count + 1, "{}", h.state().status());
+    assert_eq!(pasted.bodies[count].alias, "box 1 2");
+    assert!(h.state().overlaps().is_empty(), "pasted in free space");
+
+    // The handle above the selected box turns it: dragged from straight above the origin
+    // to straight right of it, a quarter turn clockwise on screen.
+    click_world(&mut h, 400.0, 365.0, Modifiers::NONE);
+    let app = h.state();
+    let sim = app.sim().unwrap();
+    let i = app.followed().expect("box 1 is selected");
+    let body = sim.world.body(sim.bodies[i].handle).unwrap();
+    let origin = app.camera().to_screen(app.canvas_rect(), body.origin());
+    let top = body
+        .world_vertices()
+        .map(|v| app.camera().to_screen(app.canvas_rect(), v).y)
+        .fold(f32::INFINITY, f32::min);
+    let handle = egui::pos2(origin.x, top - 24.0);
+    let right = origin + egui::vec2(origin.y - handle.y, 0.0);
+    drag_screen(&mut h, handle, right, 6);
+    let turned = scene(&h)
+        .bodies
+        .iter()
+        .find(|b| b.alias == "box 1")
+        .unwrap()
+        .clone();
+    assert!(
+        (turned.orientation - std::f64::consts::FRAC_PI_2).abs() < 1e-6,
+        "orientation {}",
+        turned.orientation
+    );
+    assert_eq!(
+        (turned.x, turned.y),
+        (400.0, 365.0),
+        "turned about its origin"
+    );
+
+    h.get_by_label("File").click();
+    h.run_steps(2);
+    click(&mut h, "Export view as SVG…");
+    let text = std::fs::read_to_string(&svg).expect("the view was written");
+    assert!(text.starts_with("<svg") && text.matches("<polygon").count() > count);
+
+    h.key_press(Key::F1);
+    h.run_steps(2);
+    h.get_by_label_contains("Back to step 0");
 }

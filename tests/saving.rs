@@ -220,10 +220,15 @@ fn a_file_that_could_not_be_read_is_never_written_over() {
     assert!(db.model.bodies.is_empty());
     db.model.scenes[0].friction = 0.25;
     db.save(Overwrite::Never).unwrap();
-    assert!(bodies.join("keep").exists(), "the unreadable file was left alone");
+    assert!(
+        bodies.join("keep").exists(),
+        "the unreadable file was left alone"
+    );
     assert_eq!(Database::load(dir.path()).0.model.scenes[0].friction, 0.25);
 
-    db.model.bodies.push(db.model.bodies.first().cloned().unwrap_or_default());
+    db.model
+        .bodies
+        .push(db.model.bodies.first().cloned().unwrap_or_default());
     assert!(matches!(
         db.save(Overwrite::Never),
         Err(SaveError::WouldDropRecords(path)) if path == bodies

@@ -1,0 +1,528 @@
+//! The canvas: draws a simulation with its debug overlays, pans and zooms, selects a body
+//! by clicking it, drags a body by the grabbed point while it runs, and at step 0 moves
+//! and turns placements. It returns commands; the picture itself is `draw`'s.
+
+pub mod body_editor;
+pub mod draw;
+
+use super::Command;
+use super::camera::Camera;
+use super::tools::Tool;
+use super::world_bound::WorldBound;
+use crate::sim::Simulation;
+use egui::{Color32, PointerButton, Rect, Sense, Stroke};
+use pe::collide::Aabb;
+use pe::{BodyHandle, Vec2};
+
+/// Which overlays to draw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DebugDraw {
+    pub contacts: bool,
+    pub joints: bool,
+    pub bounds: bool,
+    pub centres: bool,
+    pub velocities: bool,
+    pub grid: bool,
+    /// Sleeping bodies drawn faded, with a "z".
+    pub sleeping: bool,
+    /// The view follows the selected body, or the moving bodies' mean position.
+    pub follow: bool,
+    /// The physics islands of the last step, in a window of their own.
+    pub islands: bool,
+}
+
+impl Default for DebugDraw {
+    fn default() -> Self {
+        Self {
+            contacts: true,
+            joints: true,
+            bounds: false,
+            centres: false,
+            velocities: false,
+            grid: true,
+            sleeping: true,
+            follow: true,
+            islands: false,
+        }
+    }
+}
+
+/// A body held by the mouse: a damped spring from the grabbed point (in body space) to the
+/// pointer, scaled by the body's mass so light and heavy bodies follow alike.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grab {
+    pub body: BodyHandle,
+    pub local_point: Vec2,
+    pub target: Vec2,
+}
+
+impl Grab {
+    /// Spring frequency of the mouse joint (Hz) and its damping ratio.
+    const FREQUENCY: f64 = 4.0;
+    const DAMPING: f64 = 0.9;
+
+    pub fn apply(&self, sim: &mut Simulation) {
+        sim.world.wake_body(self.body);
+        let Some(body) = sim.world.body_mut(self.body) else {
+            return;
+        };
+        if body.is_static() {
+            return;
+        }
+        let point = body.to_world(self.local_point);
+        let omega = 2.0 * std::f64::consts::PI * Self::FREQUENCY;
+        let m = body.mass();
+        let force = (self.target - point) * (m * omega * omega)
+            - body.velocity_at(point) * (2.0 * m * Self::DAMPING * omega);
+        body.apply_force_at(force, point);
+    }
+}
+
+/// How the canvas looks at the world, and what a click on it does.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CanvasView {
+    pub camera: Camera,
+    /// The camera frames what is shown; false: fit it on the next frame.
+    pub fitted: bool,
+    /// What the next fit frames instead of the moving bodies.
+    pub fit_area: Option<Aabb>,
+    pub debug: DebugDraw,
+    /// Where the canvas was drawn last frame (screen points), to map clicks to the world.
+    pub rect: Rect,
+    pub tool: Tool,
+    /// Grid spacing edits snap to (None: free).
+    pub snap_step: Option<f64>,
+    /// The vertex being dragged in the body editor.
+    pub vertex_drag: Option<usize>,
+}
+
+impl Default for CanvasView {
+    fn default() -> Self {
+        Self {
+            camera: Camera::default(),
+            fitted: false,
+            fit_area: None,
+            debug: DebugDraw::default(),
+            rect: Rect::NOTHING,
+            tool: Tool::Select,
+            snap_step: Some(0.5),
+            vertex_drag: None,
+        }
+    }
+}
+
+/// What the scene canvas shows this frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Scene<'a> {
+    pub sim: &'a Simulation,
+    /// Paused at step 0: drags move placements instead of grabbing bodies.
+    pub editing: bool,
+    /// The body the inspector and plots follow (index into `sim.bodies`).
+    pub followed: Option<usize>,
+    pub overlaps: &'a [(usize, usize)],
+    pub bound: Option<&'a WorldBound>,
+}
+
+/// Points between a selected body's outline and its rotate handle.
+const HANDLE_OFFSET: f32 = 24.0;
+const HANDLE_RADIUS: f32 = 6.0;
+
+impl CanvasView {
+    /// Frames the scene (or the body being edited) on the next frame.
+    pub fn fit(&mut self) {
+        self.fitted = false;
+        self.fit_area = None;
+    }
+
+    /// An empty canvas that says why.
+    pub fn nothing(&mut self, ui: &mut egui::Ui, why: &str) {
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::hover());
+        self.rect = response.rect;
+        painter.rect_filled(self.rect, 0.0, draw::BACKGROUND);
+        painter.text(
+            self.rect.center(),
+            egui::Align2::CENTER_CENTER,
+            why,
+            egui::FontId::proportional(16.0),
+            Color32::GRAY,
+        );
+    }
+
+    /// The scene canvas; `grab` is the body the mouse holds while the scene runs.
+    pub fn scene_ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        scene: Scene<'_>,
+        grab: &mut Option<Grab>,
+    ) -> Vec<Command> {
+        let (response, painter) = ui.allocate_painter(ui.available_size(), Sense::click_and_drag());
+        self.rect = response.rect;
+        if !self.fitted {
+            self.fit_now(scene.sim);
+        } else {
+            self.navigate(ui, &response, scene);
+        }
+        let mut commands = Vec::new();
+        let followed = self.pointer(ui, &response, scene, grab, &mut commands);
+        let selected: Vec<usize> = followed.into_iter().collect();
+        let marks = draw::Highlights {
+            selected: &selected,
+            overlaps: if scene.editing { scene.overlaps } else { &[] },
+        };
+        painter.extend(draw::scene(
+            scene.sim,
+            &self.camera,
+            self.rect,
+            &self.debug,
+            marks,
+        ));
+        self.handle_and_grab(&painter, scene, followed, grab.as_ref());
+        self.hints(ui, &painter, scene);
+        commands
+    }
+
+    fn fit_now(&mut self, sim: &Simulation) {
+        let area = self.fit_area.map(|a| {
+            let margin = (a.max - a.min) * 0.05;
+            (a.min - margin, a.max + margin)
+        });
+        if let Some((min, max)) = area.or_else(|| fit_bounds(sim)) {
+            self.camera.fit(self.rect, min, max);
+        }
+        self.fitted = true;
+        self.fit_area = None;
+    }
+
+    /// Pans with the secondary or middle button, zooms with the wheel about the pointer,
+    /// and eases towards what Follow follows.
+    fn navigate(&mut self, ui: &egui::Ui, response: &egui::Response, scene: Scene<'_>) {
+        if pan(&mut self.camera, response) {
+            self.debug.follow = false;
+        }
+        zoom(&mut self.camera, ui, response, self.rect);
+        // Following stops while editing: the view must hold still under the user's clicks.
+        if self.debug.follow
+            && !scene.editing
+            && let Some(target) = follow_point(scene.sim, scene.followed, scene.bound)
+        {
+            // Ease towards the target so that the view does not shake with the bodies.
+            self.camera.centre += (target - self.camera.centre) * 0.1;
+        }
+    }
+
+    /// Clicks and drags with the primary button; returns the body followed after them.
+    fn pointer(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        scene: Scene<'_>,
+        grab: &mut Option<Grab>,
+        commands: &mut Vec<Command>,
+    ) -> Option<usize> {
+        let (camera, rect, sim) = (self.camera, self.rect, scene.sim);
+        let pointer = response
+            .interact_pointer_pos()
+            .map(|p| camera.to_world(rect, p));
+        // A drag is recognised only once the pointer has moved a few points: pick and grab
+        // where the button went down, not where the pointer is by then.
+        let pressed_screen = ui.input(|i| i.pointer.press_origin());
+        let pressed = pressed_screen.map(|p| camera.to_world(rect, p));
+        let drag_started = response.drag_started_by(PointerButton::Primary);
+        let selecting = !scene.editing || self.tool == Tool::Select;
+        if scene.editing && !selecting && response.clicked() {
+            commands.extend(pointer.map(Command::UseTool));
+        }
+        let turning_id = response.id.with("turning");
+        if scene.editing
+            && drag_started
+            && let Some(p) = pressed_screen
+        {
+            let on_handle = self
+                .handle(sim, scene.followed)
+                .is_some_and(|h| h.distance(p) <= HANDLE_RADIUS + 4.0);
+            ui.ctx().data_mut(|d| d.insert_temp(turning_id, on_handle));
+        }
+        let turning = scene.editing && ui.ctx().data(|d| d.get_temp(turning_id).unwrap_or(false));
+        let mut followed = scene.followed;
+        if selecting && !turning && (drag_started || response.clicked()) {
+            let at = if drag_started { pressed } else { pointer };
+            let hit = at.and_then(|p| body_at(sim, p, scene.followed));
+            if hit != followed {
+                followed = hit;
+                commands.push(Command::Follow(hit));
+            }
+            if drag_started && !scene.editing {
+                *grab = hit.zip(at).and_then(|(i, p)| grab_at(sim, i, p));
+            }
+        }
+        if let (Some(g), Some(p)) = (grab.as_mut(), pointer) {
+            g.target = p;
+        }
+        if scene.editing
+            && selecting
+            && let (Some(i), Some(p)) = (followed, pointer)
+        {
+            let dragging = response.dragged_by(PointerButton::Primary)
+                && response.drag_delta() != egui::Vec2::ZERO;
+            if turning {
+                commands.extend(turn(ui, sim, i, pressed, p, dragging));
+            } else {
+                commands.extend(move_by_drag(ui, response, sim, i, pressed, p, dragging));
+            }
+        }
+        if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
+            *grab = None;
+            ui.ctx().data_mut(|d| d.insert_temp(turning_id, false));
+        }
+        followed
+    }
+
+    /// Where the rotate handle of body `i` is on screen: above its outline.
+    fn handle(&self, sim: &Simulation, i: Option<usize>) -> Option<egui::Pos2> {
+        let body = sim.bodies.get(i?).and_then(|b| sim.world.body(b.handle))?;
+        let top = body
+            .world_vertices()
+            .map(|v| self.camera.to_screen(self.rect, v).y)
+            .fold(f32::INFINITY, f32::min);
+        let origin = self.camera.to_screen(self.rect, body.origin());
+        Some(egui::pos2(origin.x, top - HANDLE_OFFSET))
+    }
+
+    fn handle_and_grab(
+        &self,
+        painter: &egui::Painter,
+        scene: Scene<'_>,
+        followed: Option<usize>,
+        grab: Option<&Grab>,
+    ) {
+        let to_screen = |p: Vec2| self.camera.to_screen(self.rect, p);
+        if scene.editing
+            && self.tool == Tool::Select
+            && let Some(h) = self.handle(scene.sim, followed)
+            && let Some(body) = followed
+                .and_then(|i| scene.sim.bodies.get(i))
+                .and_then(|b| scene.sim.world.body(b.handle))
+        {
+            let stroke = Stroke::new(1.5, Color32::from_rgb(255, 220, 80));
+            painter.line_segment([to_screen(body.origin()), h], stroke);
+            painter.circle(h, HANDLE_RADIUS, Color32::from_rgb(60, 60, 70), stroke);
+        }
+        if let Some(g) = grab
+            && let Some(body) = scene.sim.world.body(g.body)
+        {
+            let from = to_screen(body.to_world(g.local_point));
+            painter.line_segment(
+                [from, to_screen(g.target)],
+                Stroke::new(1.5, Color32::WHITE),
+            );
+            painter.circle_filled(from, 3.0, Color32::WHITE);
+        }
+    }
+
+    fn hints(&self, ui: &mut egui::Ui, painter: &egui::Painter, scene: Scene<'_>) {
+        if !scene.editing {
+            return;
+        }
+        let hint = match self.tool {
+            Tool::Select => {
+                "editing at step 0: drag a body to move it · drag its handle or Q / E to turn it · Play runs"
+            }
+            Tool::Joint => "joint tool: click a point where two bodies overlap to pin them there",
+        };
+        painter.text(
+            self.rect.left_top() + egui::vec2(8.0, 8.0),
+            egui::Align2::LEFT_TOP,
+            hint,
+            egui::FontId::proportional(13.0),
+            Color32::from_gray(170),
+        );
+        if !scene.overlaps.is_empty() {
+            let text = overlap_note(scene.sim, scene.overlaps);
+            draw::note(ui, self.rect, 1, draw::OVERLAP, &text);
+        }
+    }
+}
+
+/// Pans the camera with the secondary or middle button; whether it moved.
+pub fn pan(camera: &mut Camera, response: &egui::Response) -> bool {
+    if response.dragged_by(PointerButton::Secondary) || response.dragged_by(PointerButton::Middle) {
+        let d = response.drag_delta();
+        camera.centre -= Vec2::new(d.x as f64, d.y as f64) / camera.zoom;
+        return true;
+    }
+    false
+}
+
+/// Zooms with the wheel about the pointer.
+pub fn zoom(camera: &mut Camera, ui: &egui::Ui, response: &egui::Response, rect: Rect) {
+    if let Some(hover) = response.hover_pos() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            camera.zoom_about(rect, hover, (scroll as f64 * 0.002).exp());
+        }
+    }
+}
+
+/// The mouse spring on body `i` of `sim` at world point `p`, unless it is static.
+fn grab_at(sim: &Simulation, i: usize, p: Vec2) -> Option<Grab> {
+    let handle = sim.bodies.get(i)?.handle;
+    let body = sim.world.body(handle).filter(|b| !b.is_static())?;
+    Some(Grab {
+        body: handle,
+        local_point: body.to_local(p),
+        target: p,
+    })
+}
+
+/// Dragging body `i` at step 0 moves its placement, keeping the grabbed point under the
+/// pointer `p`.
+fn move_by_drag(
+    ui: &egui::Ui,
+    response: &egui::Response,
+    sim: &Simulation,
+    i: usize,
+    pressed: Option<Vec2>,
+    p: Vec2,
+    dragging: bool,
+) -> Option<Command> {
+    let origin = sim
+        .bodies
+        .get(i)
+        .and_then(|b| sim.world.body(b.handle))?
+        .origin();
+    let offset_id = response.id.with("placement drag offset");
+    if response.drag_started_by(PointerButton::Primary)
+        && let Some(pressed) = pressed
+    {
+        ui.ctx()
+            .data_mut(|d| d.insert_temp(offset_id, pressed - origin));
+    }
+    let offset = ui.ctx().data(|d| d.get_temp::<Vec2>(offset_id))?;
+    dragging.then_some(Command::MovePlacement {
+        body: i,
+        to: p - offset,
+    })
+}
+
+/// Dragging the rotate handle of body `i` turns its placement by the angle the pointer
+/// swept about the body's origin; with Shift held, to whole 15° steps.
+fn turn(
+    ui: &egui::Ui,
+    sim: &Simulation,
+    i: usize,
+    pressed: Option<Vec2>,
+    p: Vec2,
+    dragging: bool,
+) -> Option<Command> {
+    let body = sim.bodies.get(i).and_then(|b| sim.world.body(b.handle))?;
+    let origin = body.origin();
+    let start_id = egui::Id::unique(("turn start", i));
+    if !dragging {
+        ui.ctx().data_mut(|d| d.remove::<(f64, f64)>(start_id));
+        return None;
+    }
+    let pressed = pressed?;
+    let bearing = |q: Vec2| (q.y - origin.y).atan2(q.x - origin.x);
+    let (angle_at_press, bearing_at_press) = ui
+        .ctx()
+        .data_mut(|d| *d.get_temp_mut_or_insert_with(start_id, || (body.angle, bearing(pressed))));
+    let mut target = angle_at_press + bearing(p) - bearing_at_press;
+    if ui.input(|i| i.modifiers.shift) {
+        let step = 15f64.to_radians();
+        target = (target / step).round() * step;
+    }
+    let delta = target - body.angle;
+    (delta.abs() > 1e-9).then_some(Command::TurnPlacement {
+        body: i,
+        angle: delta,
+    })
+}
+
+/// "a overlaps b: …" for the first overlapping pair, with a count of the others.
+fn overlap_note(sim: &Simulation, overlaps: &[(usize, usize)]) -> String {
+    let Some(&(a, b)) = overlaps.first() else {
+        return String::new();
+    };
+    let more = match overlaps.len() - 1 {
+        0 => String::new(),
+        n => format!(" (and {n} more pairs)"),
+    };
+    format!(
+        "{} overlaps {}{more}: the first step pushes them apart; drag one clear",
+        sim.bodies[a].id, sim.bodies[b].id
+    )
+}
+
+/// The selected body's centroid, or the mean centroid of the moving bodies (those still
+/// inside the world bound).
+fn follow_point(
+    sim: &Simulation,
+    selected: Option<usize>,
+    bound: Option<&WorldBound>,
+) -> Option<Vec2> {
+    if let Some(body) = selected
+        .and_then(|i| sim.bodies.get(i))
+        .and_then(|b| sim.world.body(b.handle))
+    {
+        return Some(body.centroid());
+    }
+    let moving: Vec<Vec2> = sim
+        .world
+        .bodies()
+        .filter(|(h, b)| !b.is_static() && !bound.is_some_and(|w| w.is_stopped(*h)))
+        .map(|(_, b)| b.centroid())
+        .collect();
+    (!moving.is_empty()).then(|| moving.iter().sum::<Vec2>() / moving.len() as f64)
+}
+
+/// Whether body `i` of `sim` covers `p`.
+fn covers(sim: &Simulation, i: usize, p: Vec2) -> bool {
+    let Some(body) = sim.bodies.get(i).and_then(|b| sim.world.body(b.handle)) else {
+        return false;
+    };
+    let verts: Vec<Vec2> = body.world_vertices().collect();
+    let side = |k: usize| {
+        let (a, c) = (verts[k], verts[(k + 1) % verts.len()]);
+        pe::math::cross(c - a, p - a)
+    };
+    (0..verts.len()).all(|k| side(k) >= 0.0) || (0..verts.len()).all(|k| side(k) <= 0.0)
+}
+
+/// The body a press at `p` takes: the selected one if it covers `p`, else the topmost
+/// (last drawn) that does.
+pub fn body_at(sim: &Simulation, p: Vec2, selected: Option<usize>) -> Option<usize> {
+    if let Some(i) = selected
+        && covers(sim, i, p)
+    {
+        return Some(i);
+    }
+    draw::drawing_order(sim)
+        .into_iter()
+        .rev()
+        .find(|&i| covers(sim, i, p))
+}
+
+/// The world rectangle around every body, the static ones clipped to the dynamic ones'
+/// neighbourhood so that a long floor does not shrink the robots to dots.
+fn fit_bounds(sim: &Simulation) -> Option<(Vec2, Vec2)> {
+    let dynamic = super::placing::bounds_of(
+        sim.world
+            .bodies()
+            .filter(|(_, b)| !b.is_static())
+            .flat_map(|(_, b)| b.world_vertices().collect::<Vec<_>>()),
+    );
+    let all = || {
+        super::placing::bounds_of(
+            sim.world
+                .bodies()
+                .flat_map(|(_, b)| b.world_vertices().collect::<Vec<_>>()),
+        )
+    };
+    let aabb = dynamic.or_else(all)?;
+    // Room around the bodies for them to move, and the ground below them.
+    let size = (aabb.max - aabb.min).norm().max(50.0);
+    Some((
+        aabb.min - Vec2::repeat(0.6 * size),
+        aabb.max + Vec2::repeat(0.6 * size),
+    ))
+}

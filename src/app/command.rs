@@ -1,0 +1,121 @@
+//! What the panels ask the app to do. Panels read the document and the runner and return
+//! commands; the app applies them in one place (`RoboSimApp::apply`), so that no panel
+//! edits the model, runs the physics or touches a file itself.
+
+use super::Selection;
+use super::canvas::DebugDraw;
+use super::document::ItemKind;
+use super::inspector::NewPlacement;
+use super::tools::Tool;
+use crate::db::Delete;
+use crate::model::Model;
+use pe::{ContactSolver, Vec2};
+use std::path::PathBuf;
+
+/// Where the user goes from this database, once the unsaved-changes question (if any) is
+/// answered.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AfterSave {
+    Quit,
+    Open(PathBuf),
+    OpenExamples,
+    NewDatabase,
+}
+
+/// Pictures of the canvas the app can write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Svg,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    // Files.
+    /// Ask for a folder and open it.
+    AskOpen,
+    /// Leave this database for another (asking first about unsaved changes).
+    Open(AfterSave),
+    NewDatabase,
+    /// Do what `AfterSave` says without saving.
+    Discard(AfterSave),
+    /// Save, then do what `AfterSave` says.
+    SaveThen(AfterSave),
+    Save,
+    SaveAs,
+    /// Save although some body cannot be simulated (the user was asked).
+    SaveAnyway,
+    /// Save over files changed on disk, or dropping unreadable records (the user was asked).
+    SaveOverwriting,
+    Revert,
+    Quit,
+    ExportPlots,
+    ExportView(ImageFormat),
+    /// Take up (or forget) the unsaved work an earlier session kept for `folder`.
+    Restore(Option<PathBuf>, Model),
+    DiscardKeptWork(Option<PathBuf>),
+
+    // Edits of the model.
+    Select(Selection),
+    /// Make `draft` the model; `key` names the field, so that a drag is one undo step.
+    Commit {
+        draft: Model,
+        key: String,
+    },
+    Rename(Selection, String),
+    New(ItemKind),
+    Duplicate,
+    /// Delete the selected item (the browser's button).
+    Delete(Delete),
+    /// Delete the selected placement at step 0, or else the selected item.
+    DeleteSelected,
+    Undo,
+    Redo,
+    PlaceInScene(NewPlacement),
+    /// Move the placement behind simulated body `body` so that its origin goes to `to`.
+    MovePlacement {
+        body: usize,
+        to: Vec2,
+    },
+    /// Turn the placement behind simulated body `body` by `angle` (rad) about its origin.
+    TurnPlacement {
+        body: usize,
+        angle: f64,
+    },
+    /// The current tool was used at this world point.
+    UseTool(Vec2),
+    /// The body editor changed the selected body's outline.
+    SetVertices {
+        vertices: Vec<[f64; 2]>,
+        key: String,
+    },
+    CopyPlacement,
+    CutPlacement,
+    PastePlacement,
+
+    // The simulation.
+    SetRunning(bool),
+    TogglePlay,
+    Step,
+    Reset,
+    SetSpeed(f64),
+    SetSolver(ContactSolver),
+    SetSleeping(bool),
+    /// Go back to the recorded state nearest this step.
+    ScrubTo(u64),
+
+    // The view.
+    Fit,
+    SetTool(Tool),
+    SetSnap(Option<f64>),
+    SetDebug(DebugDraw),
+    /// The body the inspector and the plots follow (index into the simulation's bodies).
+    Follow(Option<usize>),
+    ToggleProblems,
+    ShowShortcuts,
+    ShowAbout,
+
+    // Messages for the status bar.
+    Inform(String),
+    Complain(String),
+}

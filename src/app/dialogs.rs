@@ -1,0 +1,170 @@
+//! Questions the app asks before doing something that cannot be undone, and the help
+//! windows (the shortcut sheet, About). Answers come back as commands.
+
+use super::Command;
+use super::command::AfterSave;
+use super::shortcuts::SHORTCUTS;
+use crate::db::Delete;
+use crate::model::Model;
+use std::path::PathBuf;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Dialog {
+    /// Saving would overwrite a file changed on disk or drop unreadable records.
+    Overwrite(String),
+    /// Some body cannot be simulated as it is; what that means, before saving it.
+    SaveUnusable(String),
+    /// The folder the app was started on does not exist.
+    MissingFolder(PathBuf),
+    /// Unsaved changes, and the user is leaving this database.
+    Unsaved(AfterSave),
+    /// A delete refused because the item is used; offer the cascade.
+    Cascade(String),
+    /// Unsaved work from a session that did not end cleanly was found for the database in
+    /// this folder.
+    Restore(Option<PathBuf>, Model),
+}
+
+/// Shows `dialog`; once a button answers it, the commands that answer gives.
+pub fn ui(ctx: &egui::Context, dialog: &Dialog) -> Option<Vec<Command>> {
+    let mut answered = None;
+    egui::Window::new("RoboSim")
+        .collapsible(false)
+        .resizable(false)
+        .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
+        .show(ctx, |ui| {
+            ui.set_max_width(520.0);
+            let (question, answers) = question(dialog);
+            ui.label(question);
+            ui.horizontal(|ui| {
+                for (text, tip, commands) in answers {
+                    let button = ui.button(text);
+                    let button = if tip.is_empty() {
+                        button
+                    } else {
+                        button.on_hover_text(tip)
+                    };
+                    if button.clicked() {
+                        answered = Some(commands);
+                    }
+                }
+            });
+        });
+    answered
+}
+
+type Answer = (&'static str, &'static str, Vec<Command>);
+
+/// The text of `dialog` and its buttons: label, tooltip, what each does.
+fn question(dialog: &Dialog) -> (String, Vec<Answer>) {
+    let cancel = ("Cancel", "", Vec::new());
+    match dialog {
+        Dialog::Overwrite(why) => (
+            why.clone(),
+            vec![("Overwrite", "", vec![Command::SaveOverwriting]), cancel],
+        ),
+        Dialog::SaveUnusable(why) => (
+            why.clone(),
+            vec![("Save anyway", "", vec![Command::SaveAnyway]), cancel],
+        ),
+        Dialog::MissingFolder(folder) => (
+            format!("The folder {} does not exist.", folder.display()),
+            vec![
+                (
+                    "Start a new database there",
+                    "An empty database; the first Save creates the folder",
+                    Vec::new(),
+                ),
+                (
+                    "Open the examples instead",
+                    "The database built into the app",
+                    vec![Command::Open(AfterSave::OpenExamples)],
+                ),
+                ("Choose another folder…", "", vec![Command::AskOpen]),
+            ],
+        ),
+        Dialog::Unsaved(after) => (
+            "The database has unsaved changes.".to_string(),
+            vec![
+                ("Save", "", vec![Command::SaveThen(after.clone())]),
+                ("Discard", "", vec![Command::Discard(after.clone())]),
+                cancel,
+            ],
+        ),
+        Dialog::Cascade(why) => (
+            why.clone(),
+            vec![
+                (
+                    "Delete it and its placements",
+                    "",
+                    vec![Command::Delete(Delete::Cascade)],
+                ),
+                cancel,
+            ],
+        ),
+        Dialog::Restore(folder, model) => (
+            "Unsaved work from a session that ended unexpectedly was kept. Restore it?".to_string(),
+            vec![
+                (
+                    "Restore",
+                    "",
+                    vec![Command::Restore(folder.clone(), model.clone())],
+                ),
+                (
+                    "Discard it",
+                    "",
+                    vec![Command::DiscardKeptWork(folder.clone())],
+                ),
+            ],
+        ),
+    }
+}
+
+/// The shortcut sheet: every shortcut of `shortcuts::SHORTCUTS`, and the mouse.
+pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
+    egui::Window::new("Keyboard shortcuts")
+        .open(open)
+        .resizable(false)
+        .show(ctx, |ui| {
+            egui::Grid::new("shortcut sheet")
+                .striped(true)
+                .show(ui, |ui| {
+                    for (_, shortcut, what) in SHORTCUTS {
+                        ui.monospace(ctx.format_shortcut(shortcut));
+                        ui.label(*what);
+                        ui.end_row();
+                    }
+                    for (how, what) in [
+                        (
+                            "Left drag",
+                            "Move a body at step 0; pull it on a spring while running",
+                        ),
+                        (
+                            "Handle drag",
+                            "Turn the selected placement (Shift: 15° steps)",
+                        ),
+                        ("Right or middle drag", "Pan the view"),
+                        ("Wheel", "Zoom about the pointer"),
+                        (
+                            "Shift+click",
+                            "Body editor: add a vertex even if it dents the outline",
+                        ),
+                    ] {
+                        ui.monospace(how);
+                        ui.label(what);
+                        ui.end_row();
+                    }
+                });
+        });
+}
+
+pub fn about(ctx: &egui::Context, open: &mut bool) {
+    egui::Window::new("About RoboSim")
+        .open(open)
+        .resizable(false)
+        .show(ctx, |ui| {
+            ui.heading(format!("RoboSim {}", env!("CARGO_PKG_VERSION")));
+            ui.label(env!("CARGO_PKG_DESCRIPTION"));
+            ui.label(format!("Licence: {}", env!("CARGO_PKG_LICENSE")));
+        });
+}

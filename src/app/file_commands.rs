@@ -1,0 +1,315 @@
+//! Commands that read or write files: open, save (asking first when it matters), revert,
+//! unsaved work kept against a crash, and exports of the plots and the view.
+
+use super::command::{AfterSave, ImageFormat};
+use super::dialogs::Dialog;
+use super::files::Answer;
+use super::{Command, RoboSimApp, Selection, document, plots};
+use crate::db::{Overwrite, SaveError};
+use std::path::{Path, PathBuf};
+
+impl RoboSimApp {
+    pub(super) fn apply_file_command(&mut self, command: Command, ctx: &egui::Context, now: f64) {
+        match command {
+            Command::AskOpen => self.ask_and_open(ctx),
+            Command::Open(next) => self.leave_for(next, ctx),
+            Command::NewDatabase => self.leave_for(AfterSave::NewDatabase, ctx),
+            Command::Discard(next) => self.go(next, ctx),
+            Command::SaveThen(next) => {
+                self.save(Overwrite::Never, false, None);
+                if !self.doc.is_dirty() {
+                    self.go(next, ctx);
+                }
+            }
+            Command::Save => self.save(Overwrite::Never, false, None),
+            Command::SaveAs => self.save_as(),
+            Command::SaveAnyway => self.save(Overwrite::Never, true, None),
+            Command::SaveOverwriting => self.save(Overwrite::Confirmed, true, None),
+            Command::Revert => self.revert(),
+            Command::Quit => self.leave_for(AfterSave::Quit, ctx),
+            Command::ExportPlots => self.export_plots(),
+            Command::ExportView(format) => self.export_view(format, ctx),
+            Command::Restore(folder, model) => self.restore(folder, model, now),
+            Command::DiscardKeptWork(folder) => self.doc.discard_kept_work(folder.as_deref()),
+            _ => {}
+        }
+    }
+
+    /// Reads the files again, dropping unsaved edits (undoable), with the view fitted.
+    fn revert(&mut self) {
+        if self.doc.revert() {
+            self.model_changed();
+            self.view.fit();
+        }
+    }
+
+    /// Takes up the work an earlier session kept, if it was kept for this database.
+    fn restore(&mut self, folder: Option<PathBuf>, model: crate::model::Model, now: f64) {
+        if folder.as_deref() == self.doc.folder() {
+            self.commit(model, "restore", now);
+            self.view.fit();
+        }
+    }
+
+    /// Leaves this database for `next`, asking first if it has unsaved changes.
+    fn leave_for(&mut self, next: AfterSave, ctx: &egui::Context) {
+        if self.doc.is_dirty() {
+            self.dialog = Some(Dialog::Unsaved(next));
+        } else {
+            self.go(next, ctx);
+        }
+    }
+
+    fn go(&mut self, next: AfterSave, ctx: &egui::Context) {
+        match next {
+            AfterSave::Quit => {
+                self.close_confirmed = true;
+                self.doc
+                    .discard_kept_work(self.doc.folder().map(Path::to_path_buf).as_deref());
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+            AfterSave::Open(dir) => self.show_database(Some(&dir)),
+            AfterSave::OpenExamples => self.show_database(None),
+            AfterSave::NewDatabase => {
+                self.doc.start_empty();
+                self.toolbar.opened(None);
+                self.after_opening();
+                self.inform("a new, empty database: Save asks where to keep it".into());
+            }
+        }
+    }
+
+    /// Asks for a database folder and opens it.
+    fn ask_and_open(&mut self, ctx: &egui::Context) {
+        match self
+            .files
+            .folder("Open a database folder", self.doc.folder())
+        {
+            Answer::Chosen(dir) => self.leave_for(AfterSave::Open(dir), ctx),
+            Answer::Cancelled => {}
+            Answer::Unavailable => self.no_file_dialog(),
+        }
+    }
+
+    /// The system's file dialog could not open: say so, and offer the path field.
+    fn no_file_dialog(&mut self) {
+        self.complain(
+            "no file dialog could open (no desktop portal or zenity): type the folder in the \
+             path field and press Enter"
+                .into(),
+        );
+        self.toolbar.focus_path_field = true;
+    }
+
+    /// Makes the database in `folder` (or the examples) the one edited.
+    fn show_database(&mut self, folder: Option<&Path>) {
+        self.doc.reopen(folder);
+        self.toolbar.opened(folder);
+        self.after_opening();
+    }
+
+    fn after_opening(&mut self) {
+        self.select_first_scene();
+        self.copied = None;
+        self.view.fit();
+        self.offer_restore();
+    }
+
+    /// Saves to the database's folder, to `folder`, or to the folder typed in the path
+    /// field or chosen in a dialog when it has none. Unless `shapes_confirmed`, asks first
+    /// when a body's outline is not a convex polygon (the simulation cannot use it).
+    fn save(&mut self, overwrite: Overwrite, shapes_confirmed: bool, folder: Option<PathBuf>) {
+        if !shapes_confirmed
+            && let Some(question) = document::unusable_bodies_question(self.doc.model())
+        {
+            self.dialog = Some(Dialog::SaveUnusable(question));
+            return;
+        }
+        let folder = match folder {
+            Some(f) => Some(f),
+            None if self.doc.folder().is_some() => None,
+            None => {
+                let typed = self.toolbar.path_input.trim();
+                if typed.is_empty() {
+                    match self.files.folder("Save the database in…", None) {
+                        Answer::Chosen(dir) => Some(dir),
+                        Answer::Cancelled => return,
+                        Answer::Unavailable => return self.no_file_dialog(),
+                    }
+                } else {
+                    Some(PathBuf::from(typed))
+                }
+            }
+        };
+        match self.doc.save(folder.as_deref(), overwrite) {
+            Ok(()) => {
+                let saved_in = self.doc.folder().map(Path::to_path_buf);
+                self.toolbar.opened(saved_in.as_deref());
+                self.inform(format!(
+                    "saved to {}",
+                    saved_in.map_or(String::new(), |d| d.display().to_string())
+                ));
+            }
+            Err(e @ (SaveError::ChangedOnDisk(_) | SaveError::WouldDropRecords(_))) => {
+                self.dialog = Some(Dialog::Overwrite(e.to_string()));
+            }
+            Err(e) => self.complain(e.to_string()),
+        }
+    }
+
+    fn save_as(&mut self) {
+        match self
+            .files
+            .folder("Save the database in…", self.doc.folder())
+        {
+            Answer::Chosen(dir) => self.save(Overwrite::Never, false, Some(dir)),
+            Answer::Cancelled => {}
+            Answer::Unavailable => self.no_file_dialog(),
+        }
+    }
+
+    /// Keeps a copy of unsaved work, to be offered back after a crash: soon after an edit,
+    /// and when eframe asks (every 30 s and on exit).
+    pub(super) fn keep_unsaved_work(&mut self) {
+        if self.close_confirmed {
+            let folder = self.doc.folder().map(Path::to_path_buf);
+            self.doc.discard_kept_work(folder.as_deref());
+            return;
+        }
+        if let Err(e) = self.doc.keep_unsaved_work() {
+            self.complain(format!("could not keep a copy of unsaved work: {e}"));
+        }
+    }
+
+    /// Writes the copy of unsaved work when it is due; wakes the app for it.
+    pub(super) fn autosave_tick(&mut self, ctx: &egui::Context, now: f64) {
+        match self.doc.autosave_tick(now) {
+            Ok(Some(left)) => {
+                ctx.request_repaint_after(std::time::Duration::from_secs_f64(left + 0.05));
+            }
+            Ok(None) => {}
+            Err(e) => self.complain(format!("could not keep a copy of unsaved work: {e}")),
+        }
+    }
+
+    /// Offers back work an earlier session kept for this database and never saved.
+    pub(super) fn offer_restore(&mut self) {
+        if let Some(kept) = self.doc.kept_work() {
+            let folder = self.doc.folder().map(Path::to_path_buf);
+            self.dialog = Some(Dialog::Restore(folder, kept));
+        }
+    }
+
+    /// A file name for an export of what the canvas shows.
+    fn export_name(&self, what: &str, extension: &str) -> String {
+        let shown = match &self.selection {
+            Some(Selection::Scene(n) | Selection::Robot(n) | Selection::Body(n)) => n.clone(),
+            None => "robosim".to_string(),
+        };
+        format!("{shown} {what}.{extension}")
+    }
+
+    /// Where to write an export: a file the user names, or (with no dialog) next to the
+    /// database; None when the user cancelled.
+    fn export_path(&mut self, title: &str, name: String, extension: &str) -> Option<PathBuf> {
+        let folder = self.doc.folder().map(Path::to_path_buf);
+        match self
+            .files
+            .new_file(title, &name, extension, folder.as_deref())
+        {
+            Answer::Chosen(path) => Some(path),
+            Answer::Cancelled => None,
+            Answer::Unavailable => Some(folder.unwrap_or_default().join(name)),
+        }
+    }
+
+    fn write_export(&mut self, path: &Path, bytes: &[u8], what: &str) {
+        match std::fs::write(path, bytes) {
+            Ok(()) => self.inform(format!("{what} written to {}", path.display())),
+            Err(e) => self.complain(format!("cannot write {}: {e}", path.display())),
+        }
+    }
+
+    /// Writes the plotted series to a CSV file.
+    fn export_plots(&mut self) {
+        let name = self.export_name("plots", "csv");
+        if let Some(path) = self.export_path("Export the plots as CSV", name, "csv") {
+            let csv = plots::to_csv(&self.runner.plot_data);
+            self.write_export(&path, csv.as_bytes(), "plots");
+        }
+    }
+
+    /// Writes the canvas as SVG now, or asks egui for a screenshot to write as PNG.
+    fn export_view(&mut self, format: ImageFormat, ctx: &egui::Context) {
+        let (extension, title) = match format {
+            ImageFormat::Svg => ("svg", "Export the view as SVG"),
+            ImageFormat::Png => ("png", "Export the view as PNG"),
+        };
+        let name = self.export_name("view", extension);
+        let Some(path) = self.export_path(title, name, extension) else {
+            return;
+        };
+        match format {
+            ImageFormat::Svg => {
+                let Some(sim) = self.runner.sim() else {
+                    return self.complain("nothing to export: no scene is shown".into());
+                };
+                let marks = super::canvas::draw::Highlights {
+                    selected: &[],
+                    overlaps: &[],
+                };
+                let shapes = super::canvas::draw::scene(
+                    sim,
+                    &self.view.camera,
+                    self.view.rect,
+                    &self.view.debug,
+                    marks,
+                );
+                let svg = super::canvas::draw::svg(&shapes, self.view.rect);
+                self.write_export(&path, svg.as_bytes(), "view");
+            }
+            ImageFormat::Png => {
+                // The integration reads the pixels after this frame and calls back.
+                let (rect, scale) = (self.view.rect, ctx.pixels_per_point());
+                let written = self.screenshot_written.clone();
+                let repaint = ctx.clone();
+                ctx.request_screenshot(move |image| {
+                    let outcome = write_png(&image.region(&rect, Some(scale)), &path);
+                    if let Ok(mut slot) = written.lock() {
+                        *slot = Some(outcome);
+                    }
+                    repaint.request_repaint();
+                });
+            }
+        }
+    }
+
+    /// Reports a PNG export the integration finished since the last frame.
+    pub(super) fn screenshot_news(&mut self) {
+        let outcome = self
+            .screenshot_written
+            .lock()
+            .ok()
+            .and_then(|mut slot| slot.take());
+        match outcome {
+            Some(Ok(path)) => self.inform(format!("view written to {}", path.display())),
+            Some(Err(why)) => self.complain(why),
+            None => {}
+        }
+    }
+}
+
+/// Writes `image` to `path` as PNG.
+fn write_png(image: &egui::ColorImage, path: &Path) -> Result<PathBuf, String> {
+    use eframe::icon_data::IconDataExt;
+    let rgba = egui::IconData {
+        width: image.size[0] as u32,
+        height: image.size[1] as u32,
+        rgba: image.as_raw().to_vec(),
+    };
+    let png = rgba
+        .to_png_bytes()
+        .map_err(|e| format!("cannot encode the view as PNG: {e}"))?;
+    std::fs::write(path, png).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(path.to_path_buf())
+}

@@ -1,0 +1,473 @@
+//! The menu bar and the toolbar under it: files, edits, the simulation's clock and
+//! solver, tools, snapping and what the canvas draws. Every entry has a tooltip and, where
+//! it has one, shows its shortcut.
+
+use super::canvas::DebugDraw;
+use super::command::{AfterSave, ImageFormat};
+use super::runner::SPEEDS;
+use super::shortcuts::{self, Action};
+use super::tools::{self, Tool};
+use super::{Command, Selection};
+use pe::ContactSolver;
+use std::path::PathBuf;
+
+/// What the bars show, read from the app each frame.
+#[derive(Debug, Clone, Copy)]
+pub struct State<'a> {
+    pub dirty: bool,
+    pub has_folder: bool,
+    pub can_undo: bool,
+    pub can_redo: bool,
+    pub running: bool,
+    pub speed: f64,
+    pub solver: ContactSolver,
+    pub sleeping: bool,
+    pub selection: Option<&'a Selection>,
+    /// A placement is selected on the canvas at step 0 (it can be copied or cut).
+    pub placement_selected: bool,
+    pub can_paste: bool,
+    pub tool: Tool,
+    pub snap_step: Option<f64>,
+    pub debug: DebugDraw,
+}
+
+/// The toolbar's own state: the folder being typed, and the recent folders.
+#[derive(Debug, Default)]
+pub struct Toolbar {
+    pub path_input: String,
+    /// Give the path field the keyboard focus next frame.
+    pub focus_path_field: bool,
+    pub recent: Vec<String>,
+}
+
+/// A menu entry that shows the shortcut of `action` and returns whether it was clicked.
+fn entry(ui: &mut egui::Ui, enabled: bool, text: &str, action: Option<Action>, tip: &str) -> bool {
+    let mut button = egui::Button::new(text);
+    if let Some(shortcut) = action.and_then(shortcuts::of) {
+        button = button.shortcut_text(ui.ctx().format_shortcut(&shortcut));
+    }
+    ui.add_enabled(enabled, button).on_hover_text(tip).clicked()
+}
+
+impl Toolbar {
+    /// Remembers `folder` first among the recent folders.
+    pub fn opened(&mut self, folder: Option<&std::path::Path>) {
+        let Some(folder) = folder else {
+            self.path_input.clear();
+            return;
+        };
+        let label = folder.display().to_string();
+        self.recent.retain(|r| r != &label);
+        self.recent.insert(0, label.clone());
+        self.recent.truncate(8);
+        self.path_input = label;
+    }
+
+    pub fn menu_bar(&mut self, ui: &mut egui::Ui, s: State<'_>) -> Vec<Command> {
+        let mut out = Vec::new();
+        egui::MenuBar::new().ui(ui, |ui| {
+            ui.menu_button("File", |ui| self.file_menu(ui, s, &mut out));
+            ui.menu_button("Edit", |ui| edit_menu(ui, s, &mut out));
+            ui.menu_button("View", |ui| view_menu(ui, s, &mut out));
+            ui.menu_button("Help", |ui| {
+                if entry(
+                    ui,
+                    true,
+                    "Keyboard shortcuts",
+                    Some(Action::ShowShortcuts),
+                    "Every shortcut",
+                ) {
+                    out.push(Command::ShowShortcuts);
+                }
+                if entry(ui, true, "About RoboSim", None, "Version and licence") {
+                    out.push(Command::ShowAbout);
+                }
+            });
+        });
+        out
+    }
+
+    fn file_menu(&mut self, ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+        if entry(
+            ui,
+            true,
+            "New database",
+            None,
+            "An empty database, saved where you choose",
+        ) {
+            out.push(Command::NewDatabase);
+        }
+        if entry(
+            ui,
+            true,
+            "Open…",
+            Some(Action::Open),
+            "Open a database folder",
+        ) {
+            out.push(Command::AskOpen);
+        }
+        if entry(
+            ui,
+            true,
+            "Open the examples",
+            None,
+            "The database built into the app",
+        ) {
+            out.push(Command::Open(AfterSave::OpenExamples));
+        }
+        ui.add_enabled_ui(!self.recent.is_empty(), |ui| {
+            ui.menu_button("Recent", |ui| {
+                for r in &self.recent {
+                    if ui.button(r).clicked() {
+                        out.push(Command::Open(AfterSave::Open(PathBuf::from(r))));
+                    }
+                }
+            });
+        });
+        ui.separator();
+        if entry(
+            ui,
+            s.dirty || !s.has_folder,
+            "Save",
+            Some(Action::Save),
+            "Save every file atomically",
+        ) {
+            out.push(Command::Save);
+        }
+        if entry(
+            ui,
+            true,
+            "Save As…",
+            Some(Action::SaveAs),
+            "Save the database in another folder",
+        ) {
+            out.push(Command::SaveAs);
+        }
+        if entry(
+            ui,
+            s.has_folder && s.dirty,
+            "Revert",
+            None,
+            "Read the files again, dropping unsaved edits (undoable)",
+        ) {
+            out.push(Command::Revert);
+        }
+        ui.separator();
+        if entry(
+            ui,
+            true,
+            "Export plots as CSV…",
+            None,
+            "Every plotted series, one row per step",
+        ) {
+            out.push(Command::ExportPlots);
+        }
+        if entry(
+            ui,
+            true,
+            "Export view as SVG…",
+            None,
+            "The canvas as a vector drawing",
+        ) {
+            out.push(Command::ExportView(ImageFormat::Svg));
+        }
+        if entry(
+            ui,
+            true,
+            "Export view as PNG…",
+            None,
+            "The canvas as a picture",
+        ) {
+            out.push(Command::ExportView(ImageFormat::Png));
+        }
+        ui.separator();
+        if entry(
+            ui,
+            true,
+            "Quit",
+            None,
+            "Close RoboSim (asks about unsaved changes)",
+        ) {
+            out.push(Command::Quit);
+        }
+    }
+
+    pub fn toolbar(&mut self, ui: &mut egui::Ui, s: State<'_>) -> Vec<Command> {
+        let mut out = Vec::new();
+        ui.horizontal_wrapped(|ui| {
+            self.files(ui, s, &mut out);
+            ui.separator();
+            clock(ui, s, &mut out);
+            ui.separator();
+            tools_and_view(ui, s, &mut out);
+        });
+        out
+    }
+
+    fn files(&mut self, ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+        if ui
+            .button("Open…")
+            .on_hover_text("Open a database folder (bodies.xml, robots.xml, scenes.xml) (Ctrl+O)")
+            .clicked()
+        {
+            out.push(Command::AskOpen);
+        }
+        let label = ui.label("folder");
+        let typed = ui
+            .add(
+                egui::TextEdit::singleline(&mut self.path_input)
+                    .hint_text("database folder")
+                    .desired_width(140.0),
+            )
+            .labelled_by(label.id)
+            .on_hover_text("Type a folder and press Enter (for machines without a file dialog)");
+        if std::mem::take(&mut self.focus_path_field) {
+            typed.request_focus();
+        }
+        if typed.lost_focus()
+            && ui.input(|i| i.key_pressed(egui::Key::Enter))
+            && !self.path_input.trim().is_empty()
+        {
+            let folder = PathBuf::from(self.path_input.trim());
+            out.push(Command::Open(AfterSave::Open(folder)));
+        }
+        ui.separator();
+        let save = egui::Button::new(if s.dirty { "Save*" } else { "Save" });
+        if ui
+            .add_enabled(s.dirty || !s.has_folder, save)
+            .on_hover_text("Save the database, each file atomically (Ctrl+S)")
+            .clicked()
+        {
+            out.push(Command::Save);
+        }
+        for (enabled, text, tip, command) in [
+            (
+                s.can_undo,
+                "Undo",
+                "Undo the last edit (Ctrl+Z)",
+                Command::Undo,
+            ),
+            (
+                s.can_redo,
+                "Redo",
+                "Redo (Ctrl+Shift+Z or Ctrl+Y)",
+                Command::Redo,
+            ),
+            (
+                s.has_folder && s.dirty,
+                "Revert",
+                "Reload the files, dropping unsaved edits (undoable)",
+                Command::Revert,
+            ),
+        ] {
+            if ui
+                .add_enabled(enabled, egui::Button::new(text))
+                .on_hover_text(tip)
+                .clicked()
+            {
+                out.push(command);
+            }
+        }
+    }
+}
+
+fn edit_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    let items = [
+        (
+            s.can_undo,
+            "Undo",
+            Action::Undo,
+            "Undo the last edit",
+            Command::Undo,
+        ),
+        (
+            s.can_redo,
+            "Redo",
+            Action::Redo,
+            "Redo the last undone edit",
+            Command::Redo,
+        ),
+        (
+            s.placement_selected,
+            "Cut",
+            Action::Cut,
+            "Remove the selected placement, keeping a copy",
+            Command::CutPlacement,
+        ),
+        (
+            s.placement_selected,
+            "Copy",
+            Action::Copy,
+            "Copy the selected placement",
+            Command::CopyPlacement,
+        ),
+        (
+            s.can_paste,
+            "Paste",
+            Action::Paste,
+            "Paste the copied placement in free space at the view's centre",
+            Command::PastePlacement,
+        ),
+        (
+            s.selection.is_some(),
+            "Duplicate",
+            Action::Duplicate,
+            "Copy the selected item under a new name",
+            Command::Duplicate,
+        ),
+    ];
+    for (enabled, text, action, tip, command) in items {
+        if entry(ui, enabled, text, Some(action), tip) {
+            out.push(command);
+        }
+    }
+    if entry(
+        ui,
+        s.selection.is_some(),
+        "Delete",
+        Some(Action::Delete),
+        "Delete the selected placement, or the selected item (refused while it is used)",
+    ) {
+        out.push(Command::DeleteSelected);
+    }
+}
+
+fn view_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    if entry(
+        ui,
+        true,
+        "Fit to view",
+        Some(Action::Fit),
+        "Frame the scene, the robot or the body",
+    ) {
+        out.push(Command::Fit);
+    }
+    let mut debug = s.debug;
+    ui.checkbox(&mut debug.grid, "Grid");
+    ui.checkbox(&mut debug.follow, "Follow the moving bodies");
+    ui.separator();
+    debug_checkboxes(ui, &mut debug);
+    if debug != s.debug {
+        out.push(Command::SetDebug(debug));
+    }
+}
+
+fn debug_checkboxes(ui: &mut egui::Ui, debug: &mut DebugDraw) {
+    ui.checkbox(&mut debug.contacts, "Contact points and normals");
+    ui.checkbox(&mut debug.joints, "Joint anchors and gaps");
+    ui.checkbox(&mut debug.bounds, "Bounding boxes");
+    ui.checkbox(&mut debug.centres, "Centres of mass");
+    ui.checkbox(&mut debug.velocities, "Velocities");
+    ui.checkbox(&mut debug.sleeping, "Sleeping bodies (faded, \"z\")");
+    ui.checkbox(&mut debug.islands, "Physics islands")
+        .on_hover_text("How the last step solved each group of touching or pinned bodies");
+}
+
+/// Play, step, reset, speed, solver and sleeping.
+fn clock(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    let label = if s.running { "Pause" } else { "Play" };
+    let buttons = [
+        (
+            label,
+            "Start or stop the simulation (Space)",
+            Command::TogglePlay,
+        ),
+        ("Step", "Advance one physics step (S)", Command::Step),
+        (
+            "Reset",
+            "Back to step 0, with the view fitted (R)",
+            Command::Reset,
+        ),
+        ("Fit", "Fit the view to the scene (F)", Command::Fit),
+    ];
+    for (text, tip, command) in buttons {
+        if ui.button(text).on_hover_text(tip).clicked() {
+            out.push(command);
+        }
+    }
+    let mut speed = s.speed;
+    egui::ComboBox::from_id_salt("speed")
+        .width(56.0)
+        .selected_text(format!("{}×", s.speed))
+        .show_ui(ui, |ui| {
+            for v in SPEEDS {
+                ui.selectable_value(&mut speed, v, format!("{v}×"));
+            }
+        })
+        .response
+        .on_hover_text("Slow motion and fast-forward: more or fewer steps per second, the step h never changes");
+    if speed != s.speed {
+        out.push(Command::SetSpeed(speed));
+    }
+    let mut solver = s.solver;
+    egui::ComboBox::from_id_salt("solver")
+        .width(80.0)
+        .selected_text(s.solver.name())
+        .show_ui(ui, |ui| {
+            for v in ContactSolver::ALL {
+                ui.selectable_value(&mut solver, v, v.name());
+            }
+        })
+        .response
+        .on_hover_text("The contact solver: auto (exact where it is needed, fast elsewhere), exact (coupled LCP), thesis (two-stage LCP as in the thesis), soft (iterative), sequential (one contact at a time)");
+    if solver != s.solver {
+        out.push(Command::SetSolver(solver));
+    }
+    let mut sleeping = s.sleeping;
+    if ui
+        .checkbox(&mut sleeping, "Sleep")
+        .on_hover_text("Bodies at rest for half a second sleep and cost nothing until something touches them, a motor on them starts or you drag them")
+        .changed()
+    {
+        out.push(Command::SetSleeping(sleeping));
+    }
+}
+
+/// The joint tool, snapping, Follow and the debug overlays.
+fn tools_and_view(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    if matches!(s.selection, Some(Selection::Robot(_))) {
+        let joint = s.tool == Tool::Joint;
+        if ui
+            .selectable_label(joint, "Add joint")
+            .on_hover_text(
+                "Pin two bodies together: click a point where they overlap (paused at step 0)",
+            )
+            .clicked()
+        {
+            out.push(Command::SetTool(if joint {
+                Tool::Select
+            } else {
+                Tool::Joint
+            }));
+        }
+    }
+    let mut snap = s.snap_step;
+    egui::ComboBox::from_id_salt("snap")
+        .width(72.0)
+        .selected_text(match s.snap_step {
+            Some(step) => format!("snap {step}"),
+            None => "snap off".into(),
+        })
+        .show_ui(ui, |ui| {
+            for step in tools::SNAP_STEPS {
+                let label = step.map_or("off".to_string(), |v| v.to_string());
+                ui.selectable_value(&mut snap, step, label);
+            }
+        })
+        .response
+        .on_hover_text("Grid spacing that vertices, placements and joints snap to");
+    if snap != s.snap_step {
+        out.push(Command::SetSnap(snap));
+    }
+    let mut debug = s.debug;
+    ui.toggle_value(&mut debug.follow, "Follow")
+        .on_hover_text("Keep the moving bodies in view (panning turns it off)");
+    ui.menu_button("Debug draw", |ui| debug_checkboxes(ui, &mut debug))
+        .response
+        .on_hover_text(
+            "Overlays on the canvas: contacts, joints, bounds, centres, velocities, sleep, islands",
+        );
+    if debug != s.debug {
+        out.push(Command::SetDebug(debug));
+    }
+}
