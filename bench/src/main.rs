@@ -1056,7 +1056,7 @@ fn machine() -> String {
         "{model} (family {}, model {}), {cores} logical cores; pe's soft-step batches in {}",
         field("cpu family").unwrap_or("?"),
         field("model").unwrap_or("?"),
-        pe::solver::soft::lane_path_name()
+        pe::lane_path_name()
     )
 }
 

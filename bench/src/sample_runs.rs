@@ -18,8 +18,7 @@ mod samples;
 
 use crate::harness::{Timing, interleaved, measure};
 use crate::{box2d_scenes, rapier_scenes};
-use pe::solver::simultaneous::IslandMethod;
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, World};
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, IslandMethod, World};
 use samples::{BodyState, Criterion, H, NAMES, Sample, SampleBody, Tracker, Verdict};
 use std::fmt::Write as _;
 use std::time::Duration;

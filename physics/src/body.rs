@@ -10,7 +10,7 @@ use thiserror::Error;
 pub struct BodyHandle(pub u32);
 
 impl BodyHandle {
-    pub fn index(self) -> usize {
+    pub(crate) fn index(self) -> usize {
         self.0 as usize
     }
 }
@@ -35,7 +35,34 @@ pub enum BodyError {
     TooLight(f64, f64),
 }
 
-/// Everything needed to make a body: shape, material and where it starts.
+/// Everything needed to make a body: shape, material and where it starts, given to
+/// [`World::add_body`](crate::World::add_body), which checks it. [`BodyDef::new`] takes
+/// the shape and density (0: a static body) and the rest starts at rest at the origin,
+/// with no restitution and the world's friction; each setter returns the changed
+/// definition.
+///
+/// A hexagon thrown in empty space moves and turns at the speeds it was given:
+///
+/// ```
+/// use pe::{BodyDef, ConvexPolygon, Vec2, World};
+///
+/// let mut world = World::new(Vec2::zeros());
+/// let hexagon = ConvexPolygon::regular(6, 0.5).unwrap();
+/// let area = hexagon.mass_properties().area;
+/// let def = BodyDef::new(hexagon, 2.0)
+///     .restitution(0.5)
+///     .friction(0.3)
+///     .at(Vec2::new(0.0, -3.0), 0.0)
+///     .velocity(Vec2::new(1.0, 0.0), 0.5);
+/// let thrown = world.add_body(def).unwrap();
+/// for _ in 0..60 {
+///     world.step(1.0 / 60.0);
+/// }
+/// let body = world.body(thrown).unwrap();
+/// assert!((body.position - Vec2::new(1.0, -3.0)).norm() < 1e-9);
+/// assert!((body.angle - 0.5).abs() < 1e-9);
+/// assert_eq!(body.mass(), 2.0 * area);
+/// ```
 #[derive(Debug, Clone)]
 pub struct BodyDef {
     pub polygon: ConvexPolygon,
@@ -53,6 +80,7 @@ pub struct BodyDef {
 }
 
 impl BodyDef {
+    /// `polygon` in its own vertex frame, of `density` (mass per unit area).
     pub fn new(polygon: ConvexPolygon, density: f64) -> Self {
         Self {
             polygon,
@@ -99,8 +127,6 @@ pub struct Body {
     radius: f64,
     /// Distance from the centroid to the nearest edge line (the polygon is convex).
     inner_radius: f64,
-    area: f64,
-    density: f64,
     mass: f64,
     inertia: f64,
     pub(crate) inv_mass: f64,
@@ -112,7 +138,8 @@ pub struct Body {
     pub angle: f64,
     pub velocity: Vec2,
     pub angular_velocity: f64,
-    /// Force and torque accumulated since the last step, cleared by it.
+    /// Force and torque accumulated since the last step, cleared by it: add to them (or
+    /// call `apply_force_at`) to push the body through the next step.
     pub force: Vec2,
     pub torque: f64,
     /// Asleep: at rest with its island, skipped by the step until something wakes it.
@@ -183,8 +210,6 @@ impl Body {
             local_origin: -mp.centroid,
             radius,
             inner_radius,
-            area: mp.area,
-            density: def.density,
             mass,
             inertia,
             inv_mass: inverse(mass),
@@ -242,12 +267,6 @@ impl Body {
         self.inv_mass = self.inv_mass();
         self.inv_inertia = self.inv_inertia();
     }
-    pub fn area(&self) -> f64 {
-        self.area
-    }
-    pub fn density(&self) -> f64 {
-        self.density
-    }
     /// Mass; 0 for a static body (whose mass is really infinite).
     pub fn mass(&self) -> f64 {
         self.mass
@@ -257,14 +276,14 @@ impl Body {
         self.inertia
     }
     /// 1 / mass; 0 for a static body (also while asleep: the value is the body's own).
-    pub fn inv_mass(&self) -> f64 {
+    pub(crate) fn inv_mass(&self) -> f64 {
         if self.mass > 0.0 {
             1.0 / self.mass
         } else {
             0.0
         }
     }
-    pub fn inv_inertia(&self) -> f64 {
+    pub(crate) fn inv_inertia(&self) -> f64 {
         if self.inertia > 0.0 {
             1.0 / self.inertia
         } else {
@@ -286,7 +305,7 @@ impl Body {
 
     /// The radius of the largest circle about the centroid inside the body: a body moving
     /// less than half this per step cannot pass through anything.
-    pub fn inner_radius(&self) -> f64 {
+    pub(crate) fn inner_radius(&self) -> f64 {
         self.inner_radius
     }
 
@@ -295,11 +314,11 @@ impl Body {
         self.radius
     }
     /// Vertices relative to the centroid, in body axes.
-    pub fn local_vertices(&self) -> &[Vec2] {
+    pub(crate) fn local_vertices(&self) -> &[Vec2] {
         &self.local_vertices
     }
 
-    pub fn rotation(&self) -> Rot {
+    pub(crate) fn rotation(&self) -> Rot {
         Rot::new(self.angle)
     }
 
@@ -330,20 +349,9 @@ impl Body {
         self.to_world(self.local_origin)
     }
 
-    /// Moves the body so that its vertex-frame origin is at `origin`, turned by `angle`.
-    pub fn set_origin(&mut self, origin: Vec2, angle: f64) {
-        self.angle = angle;
-        self.position = origin - Rot::new(angle).apply(self.local_origin);
-    }
-
     /// Velocity of the material point at `world_point` (SPEC eq. 1).
     pub fn velocity_at(&self, world_point: Vec2) -> Vec2 {
         self.velocity + cross_scalar(self.angular_velocity, world_point - self.position)
-    }
-
-    /// A force through the centroid, until the next step.
-    pub fn apply_force(&mut self, force: Vec2) {
-        self.force += force;
     }
 
     /// A force at a world point: also a torque `r ⊗ F` (SPEC §2.2).
@@ -352,23 +360,19 @@ impl Body {
         self.torque += cross(world_point - self.position, force);
     }
 
-    pub fn apply_torque(&mut self, torque: f64) {
-        self.torque += torque;
-    }
-
     /// An impulse at a world point changes the velocities at once (SPEC eq. 5–6).
     pub fn apply_impulse_at(&mut self, impulse: Vec2, world_point: Vec2) {
         self.velocity += impulse * self.inv_mass;
         self.angular_velocity += cross(world_point - self.position, impulse) * self.inv_inertia;
     }
 
-    pub fn kinetic_energy(&self) -> f64 {
+    pub(crate) fn kinetic_energy(&self) -> f64 {
         0.5 * (self.mass * self.velocity.norm_squared()
             + self.inertia * self.angular_velocity * self.angular_velocity)
     }
 
     /// Angular momentum about the world origin: spin plus `p × m v`.
-    pub fn angular_momentum(&self) -> f64 {
+    pub(crate) fn angular_momentum(&self) -> f64 {
         self.inertia * self.angular_velocity + self.mass * cross(self.position, self.velocity)
     }
 }

@@ -15,22 +15,48 @@
 //! let y = world.body(box_).unwrap().position.y;
 //! assert!((y - 4.0).abs() < 0.05, "the box rests on the floor: {y}");
 //! ```
+//!
+//! Everything public is re-exported here, at the crate root; the modules behind it are
+//! private, so that the engine's internals can change without breaking a user.
+//!
+//! - Building a world: a [`World`], bodies from a [`BodyDef`] of a [`ConvexPolygon`], pins
+//!   from a [`JointDef`] (driven by a [`JointMotor`] or not), and the thesis's body motors
+//!   ([`BodyMotor`]). Each is checked as it is added ([`BodyError`], [`JointError`],
+//!   [`MotorError`], [`ShapeError`]), against the [`limits`] among others.
+//! - Stepping: [`World::step`], or [`World::try_step`] for the reason a step is refused
+//!   ([`StepError`]), as the world's [`StepSettings`] say ([`ContactSolver`],
+//!   [`Integrator`], [`JointSolver`]).
+//! - Reading the results: each [`Body`] by its [`BodyHandle`], each [`Joint`] by its
+//!   [`JointHandle`], the last step's [`Contact`]s and [`Manifold`]s, and how each island
+//!   was solved ([`IslandReport`]).
+//! - Geometry: [`Vec2`] (nalgebra's), [`Aabb`], [`convex_hull`], and the separating-axis
+//!   test the step finds contacts by, on polygons placed in the world ([`collide_polygons`]
+//!   on [`WorldPolygon`]s), by which the benchmark judges every engine's overlaps.
+//! - Profiling: the cycles of each stage of a step ([`stage_clock`], counted with the
+//!   feature `stage-clock` only) and the SIMD path the soft step takes
+//!   ([`lane_path_name`]).
 
-pub mod body;
-pub mod collide;
+mod body;
+mod collide;
 pub mod limits;
-pub mod math;
-pub mod shape;
-pub mod solver;
+mod math;
+mod shape;
+mod solver;
 pub mod stage_clock;
-pub mod world;
+mod world;
 
-pub use body::{Body, BodyDef, BodyError, BodyHandle};
-pub use collide::{ContactPoint, FeatureId, Manifold};
-pub use math::{Rot, Vec2};
-pub use shape::{ConvexPolygon, MassProperties, ShapeError, convex_hull};
-pub use solver::ContactSolver;
-pub use solver::contact::Contact;
-pub use solver::joint::{Joint, JointHandle, JointMotor};
-pub use solver::motor::{BodyMotor, MotorError};
-pub use world::{FALL_PER_STEP, Integrator, JointDef, JointError, StepError, StepSettings, World};
+pub use crate::{
+    body::{Body, BodyDef, BodyError, BodyHandle},
+    collide::{Aabb, ContactPoint, FeatureId, Manifold, WorldPolygon, sat::collide_polygons},
+    math::Vec2,
+    shape::{ConvexPolygon, MassProperties, ShapeError, convex_hull},
+    solver::{
+        ContactSolver,
+        contact::Contact,
+        joint::{Joint, JointHandle, JointMotor, JointSolver},
+        motor::{BodyMotor, MotorError},
+        simultaneous::{IslandMethod, IslandReport},
+        soft::lane_path_name,
+    },
+    world::{FALL_PER_STEP, Integrator, JointDef, JointError, StepError, StepSettings, World},
+};

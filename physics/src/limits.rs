@@ -29,7 +29,7 @@ pub const INCREASE: f64 = 1e6;
 
 /// `Some((what, value, limit))` for the first `(what, value, limit)` whose value is beyond
 /// its limit in magnitude (NaN counts as beyond).
-pub fn first_beyond(
+pub(crate) fn first_beyond(
     numbers: impl IntoIterator<Item = (&'static str, f64, f64)>,
 ) -> Option<(&'static str, f64, f64)> {
     numbers

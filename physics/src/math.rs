@@ -5,19 +5,19 @@ pub type Vec2 = nalgebra::Vector2<f64>;
 
 /// Perp-dot product `a ⊗ b = a_x b_y − a_y b_x`, the 2D stand-in for the cross product.
 #[inline]
-pub fn cross(a: Vec2, b: Vec2) -> f64 {
+pub(crate) fn cross(a: Vec2, b: Vec2) -> f64 {
     a.x * b.y - a.y * b.x
 }
 
 /// `a⊥ = (−a_y, a_x)`: `a` turned by +90°.
 #[inline]
-pub fn perp(a: Vec2) -> Vec2 {
+pub(crate) fn perp(a: Vec2) -> Vec2 {
     Vec2::new(-a.y, a.x)
 }
 
 /// `ω × r` for a scalar angular velocity: the velocity of a point at lever arm `r`.
 #[inline]
-pub fn cross_scalar(omega: f64, r: Vec2) -> Vec2 {
+pub(crate) fn cross_scalar(omega: f64, r: Vec2) -> Vec2 {
     Vec2::new(-omega * r.y, omega * r.x)
 }
 
@@ -25,7 +25,7 @@ pub fn cross_scalar(omega: f64, r: Vec2) -> Vec2 {
 /// reads them as a pair).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[repr(C)]
-pub struct Rot {
+pub(crate) struct Rot {
     pub cos: f64,
     pub sin: f64,
 }
@@ -39,14 +39,14 @@ impl Default for Rot {
 
 impl Rot {
     #[inline]
-    pub fn new(angle: f64) -> Self {
+    pub(crate) fn new(angle: f64) -> Self {
         let (sin, cos) = angle.sin_cos();
         Self { cos, sin }
     }
 
     /// `R(θ)·v`.
     #[inline]
-    pub fn apply(self, v: Vec2) -> Vec2 {
+    pub(crate) fn apply(self, v: Vec2) -> Vec2 {
         Vec2::new(
             self.cos * v.x - self.sin * v.y,
             self.sin * v.x + self.cos * v.y,
@@ -55,7 +55,7 @@ impl Rot {
 
     /// `R(θ)ᵀ·v`.
     #[inline]
-    pub fn apply_inverse(self, v: Vec2) -> Vec2 {
+    pub(crate) fn apply_inverse(self, v: Vec2) -> Vec2 {
         Vec2::new(
             self.cos * v.x + self.sin * v.y,
             -self.sin * v.x + self.cos * v.y,
@@ -68,20 +68,20 @@ impl Rot {
 /// as the soft step's lanes clamp; unlike `f64::clamp` it never panics: a NaN bound (a
 /// state gone non-finite, which the step reports) is passed over.
 #[inline(always)]
-pub fn clamp(x: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn clamp(x: f64, lo: f64, hi: f64) -> f64 {
     let below_hi = if hi < x { hi } else { x };
     if lo > below_hi { lo } else { below_hi }
 }
 
 /// `a` where `a > b`, else `b`: the soft step's lanes' `max`, to the bit.
 #[inline(always)]
-pub fn greater(a: f64, b: f64) -> f64 {
+pub(crate) fn greater(a: f64, b: f64) -> f64 {
     if a > b { a } else { b }
 }
 
 /// `a` where `a < b`, else `b`: the soft step's lanes' `min`, to the bit.
 #[inline(always)]
-pub fn lesser(a: f64, b: f64) -> f64 {
+pub(crate) fn lesser(a: f64, b: f64) -> f64 {
     if a < b { a } else { b }
 }
 

@@ -45,7 +45,7 @@ pub struct MassProperties {
 
 /// The most vertices a polygon may have: contact points are named by vertex indices in 15
 /// bits (`collide::sat`), far beyond any drawn body.
-pub const MAX_VERTICES: usize = 1 << 15;
+pub(crate) const MAX_VERTICES: usize = 1 << 15;
 
 impl ConvexPolygon {
     /// Validates `points` (either winding) and returns the polygon in positive order.
@@ -207,7 +207,7 @@ pub fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
 }
 
 /// Signed area: positive for the order the engine uses.
-pub fn signed_area(points: &[Vec2]) -> f64 {
+pub(crate) fn signed_area(points: &[Vec2]) -> f64 {
     let n = points.len();
     let origin = points[0];
     0.5 * (0..n)

@@ -62,8 +62,10 @@ impl Stage {
         Stage::Continuous,
     ];
 
-    /// The stage this one is a part of, if any (its cycles are counted in both).
-    pub fn within(self) -> Option<Stage> {
+    /// The stage this one is a part of, if any (its cycles are counted in both). Only the
+    /// test of the counts below reads it.
+    #[cfg(all(test, feature = "stage-clock"))]
+    fn within(self) -> Option<Stage> {
         match self {
             Stage::PreparingIslands | Stage::PreparingPoints | Stage::PreparingPlan => {
                 Some(Stage::Preparing)
@@ -95,7 +97,7 @@ pub const ENABLED: bool = cfg!(feature = "stage-clock");
 
 /// When a stage began (`mark`).
 #[derive(Debug, Clone, Copy)]
-pub struct Mark(#[cfg(feature = "stage-clock")] u64);
+pub(crate) struct Mark(#[cfg(feature = "stage-clock")] u64);
 
 #[cfg(feature = "stage-clock")]
 mod counting {
@@ -132,7 +134,7 @@ mod counting {
 
 /// Now, as the start of a stage.
 #[inline(always)]
-pub fn mark() -> Mark {
+pub(crate) fn mark() -> Mark {
     #[cfg(feature = "stage-clock")]
     {
         Mark(counting::now())
@@ -146,7 +148,7 @@ pub fn mark() -> Mark {
 /// Adds the time since `since` to `stage`'s count for this step; `Stage::Step` ends the
 /// step, keeping its counts.
 #[inline(always)]
-pub fn record(stage: Stage, since: Mark) {
+pub(crate) fn record(stage: Stage, since: Mark) {
     #[cfg(feature = "stage-clock")]
     {
         let elapsed = counting::now().wrapping_sub(since.0);

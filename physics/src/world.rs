@@ -74,19 +74,19 @@ impl Default for StepSettings {
 
 impl StepSettings {
     /// Bodies closer than this count as touching, so resting contacts persist (SPEC §3.1).
-    pub fn contact_margin(&self) -> f64 {
+    pub(crate) fn contact_margin(&self) -> f64 {
         0.02 * self.length_scale
     }
 
     /// The broad phase pairs bodies by their bounds grown by this much, and keeps those
     /// pairs while every body's bounds stay inside its grown ones (Box2D's fat bounds,
     /// 0.1 m for its 1 m boxes): a pile at rest is not paired again every step.
-    pub fn broad_phase_margin(&self) -> f64 {
+    pub(crate) fn broad_phase_margin(&self) -> f64 {
         0.1 * self.length_scale
     }
 
     /// A body slower than this (at its farthest point) counts as still, for sleeping.
-    pub fn sleep_speed(&self) -> f64 {
+    pub(crate) fn sleep_speed(&self) -> f64 {
         0.05 * self.length_scale
     }
 
@@ -97,18 +97,18 @@ impl StepSettings {
 
     /// A pair keeps its manifold while no point of either body has moved relative to the
     /// other by more than this since the manifold was found: a tenth of the slop.
-    pub fn manifold_reuse_tolerance(&self) -> f64 {
+    pub(crate) fn manifold_reuse_tolerance(&self) -> f64 {
         0.1 * self.slop()
     }
 
     /// A reference face is swapped for the other body's only when better by this much.
-    pub fn tie_tolerance(&self) -> f64 {
+    pub(crate) fn tie_tolerance(&self) -> f64 {
         0.001 * self.length_scale
     }
 
     /// Joint passes stop at a gap of a millionth of a body; the cap bounds the work when a
     /// badly broken joint cannot close in one step.
-    pub fn joint_iterations(&self, dt: f64) -> JointIterations {
+    pub(crate) fn joint_iterations(&self, dt: f64) -> JointIterations {
         JointIterations {
             position_tolerance: 1e-6 * self.length_scale,
             velocity_tolerance: 1e-6 * self.length_scale / dt,
@@ -119,7 +119,34 @@ impl StepSettings {
     }
 }
 
-/// A joint to be made: the bodies and the shared world point they pin together.
+/// A joint to be made: the bodies and the shared world point they pin together, given
+/// to [`World::add_joint`]. The two bodies turn freely about the pin unless a
+/// [`JointMotor`] drives them, and do not collide with each other unless
+/// `collide_connected` (a robot's parts overlap around their pins).
+///
+/// A wheel pinned to the world at its centre and driven by a motor at 2 rad/s, with an arm
+/// pinned to its rim:
+///
+/// ```
+/// use pe::{BodyDef, ConvexPolygon, JointDef, JointMotor, Vec2, World};
+///
+/// let mut world = World::new(Vec2::new(0.0, 9.81));
+/// let wheel = ConvexPolygon::regular(12, 0.5).unwrap();
+/// let wheel = world.add_body(BodyDef::new(wheel, 1.0)).unwrap();
+/// let arm = ConvexPolygon::rectangle(1.0, 0.2).unwrap();
+/// let arm = world.add_body(BodyDef::new(arm, 1.0).at(Vec2::new(0.5, 0.0), 0.0)).unwrap();
+///
+/// let mut axle = JointDef::new(wheel, None, Vec2::zeros());
+/// axle.motor = Some(JointMotor::new(2.0, 1000.0)); // target rad/s, most torque
+/// world.add_joint(axle).unwrap();
+/// let elbow = world.add_joint(JointDef::new(arm, Some(wheel), Vec2::new(0.5, 0.0))).unwrap();
+/// for _ in 0..60 {
+///     world.step(1.0 / 60.0);
+/// }
+/// let spin = world.body(wheel).unwrap().angular_velocity;
+/// assert!((spin - 2.0).abs() < 1e-6, "the motor holds its speed: {spin}");
+/// assert!(world.joint_gap(elbow).unwrap() < 1e-3, "the arm stays on the rim");
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointDef {
     pub body_a: BodyHandle,
@@ -132,6 +159,8 @@ pub struct JointDef {
 }
 
 impl JointDef {
+    /// Pins `body_a` to `body_b` (`None`: the static world) at the world point `anchor`,
+    /// with no motor, the two not colliding.
     pub fn new(body_a: BodyHandle, body_b: Option<BodyHandle>, anchor: Vec2) -> Self {
         Self {
             body_a,
@@ -200,7 +229,30 @@ const MAX_SUBSTEPS: usize = 8;
 /// grown bounds, to see whether they hold again (`find_candidate_pairs`).
 const RETRY_GROWN_BOUNDS: u32 = 8;
 
-/// A 2D world of rigid convex bodies.
+/// A 2D world of rigid convex bodies, pin joints and motors: bodies are added from a
+/// [`BodyDef`], joints from a [`JointDef`], and [`World::step`] advances them all. The
+/// world has no up: gravity is a vector, and with y pointing down (as on a screen) it is
+/// `(0, 9.81)`. Handles index the world's bodies and joints and are never reused.
+///
+/// A pendulum: a 2 m bar pinned to the static world at one end swings down, its centre
+/// kept 1 m from the pin.
+///
+/// ```
+/// use pe::{BodyDef, ConvexPolygon, JointDef, Vec2, World};
+///
+/// let mut world = World::new(Vec2::new(0.0, 9.81));
+/// let bar = ConvexPolygon::rectangle(2.0, 0.1).unwrap();
+/// // The bar lies along +x from the pin at the origin.
+/// let bar = world.add_body(BodyDef::new(bar, 1.0).at(Vec2::new(1.0, 0.0), 0.0)).unwrap();
+/// let pin = world.add_joint(JointDef::new(bar, None, Vec2::zeros())).unwrap();
+/// for _ in 0..30 {
+///     world.step(1.0 / 60.0);
+/// }
+/// let centre = world.body(bar).unwrap().position;
+/// assert!(centre.y > 0.5, "it swung down: {centre:?}");
+/// assert!((centre.norm() - 1.0).abs() < 1e-3, "the pin holds: {centre:?}");
+/// assert!(world.joint_gap(pin).unwrap() < 1e-3);
+/// ```
 #[derive(Debug, Clone, Default)]
 pub struct World {
     bodies: Vec<Option<Body>>,
@@ -770,6 +822,26 @@ impl World {
     ///
     /// A step refused by `try_step` does nothing; one that leaves a body's state beyond
     /// the limits is reported there, and here ignored.
+    ///
+    /// A box dropped onto a static floor comes to rest on it:
+    ///
+    /// ```
+    /// use pe::{BodyDef, ConvexPolygon, Vec2, World};
+    ///
+    /// let mut world = World::new(Vec2::new(0.0, 9.81)); // y points down
+    /// let floor = ConvexPolygon::rectangle(10.0, 1.0).unwrap(); // its top at y = 0
+    /// world.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0)).unwrap();
+    /// let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    /// let dropped = BodyDef::new(square, 1.0).at(Vec2::new(0.0, -2.0), 0.0);
+    /// let square = world.add_body(dropped).unwrap();
+    /// for _ in 0..120 {
+    ///     world.step(1.0 / 60.0);
+    /// }
+    /// let body = world.body(square).unwrap();
+    /// assert!((body.position.y + 0.5).abs() < 0.01, "on the floor: {:?}", body.position);
+    /// assert!(body.velocity.norm() < 1e-3, "at rest: {:?}", body.velocity);
+    /// assert_eq!(world.contacts().len(), 2, "touching along its bottom edge");
+    /// ```
     pub fn step(&mut self, dt: f64) {
         let _refused = self.try_step(dt);
     }
@@ -780,6 +852,16 @@ impl World {
     /// the reason; and reporting a step that left a moving body's state non-finite or
     /// beyond the limits (then the state is not to be trusted). (Bodies, joints and motors
     /// are checked when they are added.)
+    ///
+    /// ```
+    /// use pe::{StepError, Vec2, World};
+    ///
+    /// let mut world = World::new(Vec2::new(0.0, 9.81));
+    /// assert_eq!(world.try_step(0.0), Err(StepError::BadTimeStep(0.0)));
+    /// assert_eq!(world.step_count(), 0, "a refused step does nothing");
+    /// assert_eq!(world.try_step(1.0 / 60.0), Ok(()));
+    /// assert_eq!(world.step_count(), 1);
+    /// ```
     pub fn try_step(&mut self, dt: f64) -> Result<(), StepError> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(StepError::BadTimeStep(dt));

@@ -2,10 +2,9 @@
 //! enough to pivot, the soft step for the rest, in one world. Metre-sized bodies,
 //! g = 10 m/s², h = 1/60 s.
 
-use pe::solver::simultaneous::IslandMethod;
 use pe::{
-    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, JointDef, JointHandle, JointMotor, Vec2,
-    World,
+    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, IslandMethod, JointDef, JointHandle,
+    JointMotor, Vec2, World,
 };
 
 const H: f64 = 1.0 / 60.0;

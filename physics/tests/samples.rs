@@ -13,8 +13,7 @@
 #[path = "support/samples.rs"]
 mod samples;
 
-use pe::solver::simultaneous::IslandMethod;
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Vec2, World};
+use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, IslandMethod, Vec2, World};
 use samples::{BodyState, H, Sample, SampleBody, Tracker, Verdict};
 
 /// The sample's world under `solver`, with pe's tolerances scaled to its bodies, and its

@@ -2,8 +2,10 @@
 //! a 20-row pyramid, a pendulum whose bob is tiny beside its arm, and a light chain under
 //! a 500× heavier load. Metre-sized bodies, g = 10 m/s², h = 1/60 s.
 
-use pe::solver::simultaneous::IslandMethod;
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, JointDef, JointMotor, Vec2, World};
+use pe::{
+    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, IslandMethod, JointDef, JointMotor, Vec2,
+    World,
+};
 
 const G: f64 = 10.0;
 const H: f64 = 1.0 / 60.0;
@@ -223,7 +225,7 @@ fn a_light_chain_holds_a_load_500_times_heavier() {
 
 #[test]
 fn the_world_reports_how_each_island_was_solved() {
-    use pe::solver::simultaneous::IslandMethod;
+    use pe::IslandMethod;
     // Two islands on one floor: a box 1,000 times heavier on a light one, and a row of
     // three like boxes; plus a lone pendulum and a chain of three pins.
     let build = |solver: ContactSolver| {

@@ -9,8 +9,7 @@ use super::{Command, Copied, RoboSimApp, Selection, document::unique, placing, t
 use crate::db::{Delete, EditError};
 use crate::model::{Model, Placement, SceneRobot};
 use crate::sim::{PlacedBy, Simulation};
-use pe::Vec2;
-use pe::collide::Aabb;
+use pe::{Aabb, Vec2};
 
 /// Where a simulated body's placement is in the model.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,8 +2,7 @@
 //! bodies at step 0, so that the app and the tests share them.
 
 use crate::sim::{PlacedBy, Simulation};
-use pe::Vec2;
-use pe::collide::Aabb;
+use pe::{Aabb, Vec2};
 
 /// The box around a set of points (None when there are none or one is not finite).
 pub fn bounds_of(points: impl IntoIterator<Item = Vec2>) -> Option<Aabb> {

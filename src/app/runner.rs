@@ -10,8 +10,7 @@ use super::plot_data::PlotData;
 use super::world_bound::{self, WorldBound};
 use crate::model::{Model, Placement, Scene, SceneRobot};
 use crate::sim::Simulation;
-use pe::ContactSolver;
-use pe::collide::Aabb;
+use pe::{Aabb, ContactSolver};
 use std::collections::VecDeque;
 
 /// Simulation speeds offered: the physics step never changes, only steps per second.

@@ -4,8 +4,7 @@
 
 use super::placing::bounds_of;
 use crate::sim::Simulation;
-use pe::collide::Aabb;
-use pe::{BodyHandle, Vec2};
+use pe::{Aabb, BodyHandle, Vec2};
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct WorldBound {

@@ -23,7 +23,7 @@ const SMALL_SORT: usize = 64;
 const ALL_PAIRS_LIMIT: usize = 24;
 
 #[derive(Debug, Clone, Default)]
-pub struct BroadPhase {
+pub(crate) struct BroadPhase {
     /// ((cell x, cell y), body) for every cell each listed body covers, in body order.
     entries: Vec<((i64, i64), u32)>,
     /// The entries grouped by the hash of their cell, each group in body order, with
@@ -44,7 +44,7 @@ pub struct BroadPhase {
 impl BroadPhase {
     /// Candidate pairs `(i, j)`, `i < j`, whose boxes overlap, sorted, skipping pairs that
     /// `wanted` rejects. `boxes[i]` is `None` for bodies that take no part.
-    pub fn pairs(
+    pub(crate) fn pairs(
         &mut self,
         boxes: &[Option<Aabb>],
         mut wanted: impl FnMut(usize, usize) -> bool,

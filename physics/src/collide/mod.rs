@@ -2,13 +2,13 @@
 
 mod broad;
 mod pair_set;
-pub mod reuse;
-mod sat;
-pub mod toi;
+pub(crate) mod reuse;
+pub(crate) mod sat;
+pub(crate) mod toi;
 
-pub use broad::BroadPhase;
-pub use pair_set::PairSet;
-pub use sat::{collide_polygons, collide_polygons_into};
+pub(crate) use broad::BroadPhase;
+pub(crate) use pair_set::PairSet;
+pub(crate) use sat::collide_polygons_into;
 
 use crate::body::{Body, BodyHandle};
 use crate::math::Vec2;
@@ -32,7 +32,7 @@ impl Aabb {
     }
 
     /// Whether `inner` lies inside this box.
-    pub fn contains(&self, inner: &Aabb) -> bool {
+    pub(crate) fn contains(&self, inner: &Aabb) -> bool {
         self.min.x <= inner.min.x
             && self.min.y <= inner.min.y
             && inner.max.x <= self.max.x
@@ -58,7 +58,7 @@ pub struct WorldPolygon {
 
 impl WorldPolygon {
     /// Refills `self` from `body` without reallocating when the size is unchanged.
-    pub fn update(&mut self, body: &Body) {
+    pub(crate) fn update(&mut self, body: &Body) {
         self.set_vertices(body.world_vertices());
     }
 
@@ -70,14 +70,14 @@ impl WorldPolygon {
 
     /// Refills the vertices only; `ensure_normals` adds the normals when a test needs
     /// them (a pile at rest reuses its manifolds and needs only the bounds).
-    pub fn set_outline(&mut self, vertices: impl Iterator<Item = Vec2>) {
+    pub(crate) fn set_outline(&mut self, vertices: impl Iterator<Item = Vec2>) {
         self.vertices.clear();
         self.vertices.extend(vertices);
         self.normals.clear();
     }
 
     /// Computes the edge normals if `set_outline` left them out.
-    pub fn ensure_normals(&mut self) {
+    pub(crate) fn ensure_normals(&mut self) {
         if !self.normals.is_empty() {
             return;
         }
@@ -154,7 +154,7 @@ impl Manifold {
     }
 
     /// The deepest penetration of the manifold.
-    pub fn depth(&self) -> f64 {
+    pub(crate) fn depth(&self) -> f64 {
         self.points()
             .iter()
             .map(|p| p.depth)

@@ -5,7 +5,7 @@
 /// binary search over all of them was 60% of the broad phase's time on a 100 × 100 grid of
 /// 19,800 pins.)
 #[derive(Debug, Clone, Default)]
-pub struct PairSet {
+pub(crate) struct PairSet {
     /// Sorted, without repeats.
     pairs: Vec<(u32, u32)>,
     /// `pairs[starts[i]..starts[i + 1]]` are the pairs whose first body is `i`.
@@ -15,7 +15,7 @@ pub struct PairSet {
 impl PairSet {
     /// Replaces the set with `pairs` (each `(i, j)` with `i < j`, in any order, repeats
     /// allowed).
-    pub fn rebuild(&mut self, pairs: impl IntoIterator<Item = (u32, u32)>) {
+    pub(crate) fn rebuild(&mut self, pairs: impl IntoIterator<Item = (u32, u32)>) {
         self.pairs.clear();
         self.pairs.extend(pairs);
         self.pairs.sort_unstable();
@@ -32,7 +32,7 @@ impl PairSet {
     }
 
     /// Whether `(i, j)`, `i < j`, is in the set.
-    pub fn contains(&self, (i, j): (u32, u32)) -> bool {
+    pub(crate) fn contains(&self, (i, j): (u32, u32)) -> bool {
         let i = i as usize;
         if i + 1 >= self.starts.len() {
             return false; // no pair begins with a body past the last pair's

@@ -16,7 +16,7 @@ use crate::math::{Rot, Vec2};
 /// Where a body is for the narrow phase: centroid, rotation, and the radius of the circle
 /// about the centroid that holds it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Pose {
+pub(crate) struct Pose {
     pub position: Vec2,
     pub rotation: Rot,
     pub angle: f64,
@@ -24,7 +24,7 @@ pub struct Pose {
 }
 
 impl Pose {
-    pub fn of(body: &Body) -> Self {
+    pub(crate) fn of(body: &Body) -> Self {
         Self {
             position: body.position,
             rotation: body.rotation(),
@@ -34,7 +34,7 @@ impl Pose {
     }
 
     /// A point given in the body's frame (about its centroid), in world coordinates.
-    pub fn to_world(self, local: Vec2) -> Vec2 {
+    pub(crate) fn to_world(self, local: Vec2) -> Vec2 {
         self.position + self.rotation.apply(local)
     }
 
@@ -76,7 +76,7 @@ struct CachedManifold {
 /// step parts from them (a new pair's manifold stored, or one of `last`'s left out); a
 /// pair found afresh replaces its own manifold there.
 #[derive(Debug, Clone, Default)]
-pub struct ManifoldCache {
+pub(crate) struct ManifoldCache {
     last: Vec<CachedManifold>,
     next: Vec<CachedManifold>,
     cursor: usize,
@@ -87,7 +87,7 @@ pub struct ManifoldCache {
 impl ManifoldCache {
     /// Starts a step: the manifolds kept in the last one become the ones to reuse. Pairs
     /// must then be visited in increasing order.
-    pub fn begin_step(&mut self) {
+    pub(crate) fn begin_step(&mut self) {
         match self.kept_in_place {
             Some(kept) => self.last.truncate(kept),
             None => std::mem::swap(&mut self.last, &mut self.next),
@@ -98,7 +98,7 @@ impl ManifoldCache {
     }
 
     /// Forgets every manifold.
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.last.clear();
         self.next.clear();
         self.cursor = 0;
@@ -133,7 +133,7 @@ impl ManifoldCache {
     /// memory point by point and then copied there whole, the copy's wide loads waited on
     /// the narrower stores just made (a store cannot be forwarded to a load wider than
     /// it): over a third of large_pyramid's narrow phase.
-    pub fn reuse_into(
+    pub(crate) fn reuse_into(
         &mut self,
         (a, pose_a): (BodyHandle, &Pose),
         (b, pose_b): (BodyHandle, &Pose),
@@ -192,7 +192,12 @@ impl ManifoldCache {
     }
 
     /// Keeps a freshly found manifold for the next steps.
-    pub fn store(&mut self, manifold: &Manifold, (pose_a, pose_b): (&Pose, &Pose), margin: f64) {
+    pub(crate) fn store(
+        &mut self,
+        manifold: &Manifold,
+        (pose_a, pose_b): (&Pose, &Pose),
+        margin: f64,
+    ) {
         if manifold.points().is_empty() {
             return;
         }
@@ -249,7 +254,8 @@ impl ManifoldCache {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::collide::{WorldPolygon, collide_polygons};
+    use crate::collide::WorldPolygon;
+    use crate::collide::sat::collide_polygons;
 
     impl ManifoldCache {
         /// `reuse_into` a list of its own: the manifold reused, if any.

@@ -29,7 +29,7 @@ pub fn collide_polygons(
 /// A narrow phase's list: returned by value and then pushed, each manifold was copied
 /// through the stack, and the copy's wide loads waited on the narrower stores that had
 /// just written it (a sixth of `World::detect_contacts`' own samples in the smash).
-pub fn collide_polygons_into(
+pub(crate) fn collide_polygons_into(
     (handle_a, a): (BodyHandle, &WorldPolygon),
     (handle_b, b): (BodyHandle, &WorldPolygon),
     (margin, tie_tolerance): (f64, f64),

@@ -8,19 +8,19 @@ use crate::math::{Rot, Vec2};
 /// The SAT separation of two convex polygons: the largest gap along any edge normal of
 /// either. It is positive exactly when they are apart, and never more than their distance
 /// (a projection does not lengthen), so advancing by it cannot step past a contact.
-pub fn separation(p: &WorldPolygon, q: &WorldPolygon) -> f64 {
+pub(crate) fn separation(p: &WorldPolygon, q: &WorldPolygon) -> f64 {
     max_separation(p, q).1.max(max_separation(q, p).1)
 }
 
 /// A body's straight-line motion over one step: centroid and angle at the start and end.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sweep {
+pub(crate) struct Sweep {
     pub start: (Vec2, f64),
     pub end: (Vec2, f64),
 }
 
 impl Sweep {
-    pub fn at(&self, t: f64) -> (Vec2, f64) {
+    pub(crate) fn at(&self, t: f64) -> (Vec2, f64) {
         (
             self.start.0 + (self.end.0 - self.start.0) * t,
             self.start.1 + (self.end.1 - self.start.1) * t,
@@ -35,7 +35,7 @@ impl Sweep {
 }
 
 /// Places `local` (vertices about the centroid) at `pose`.
-pub fn place(polygon: &mut WorldPolygon, local: &[Vec2], (centre, angle): (Vec2, f64)) {
+pub(crate) fn place(polygon: &mut WorldPolygon, local: &[Vec2], (centre, angle): (Vec2, f64)) {
     let rot = Rot::new(angle);
     polygon.set_vertices(local.iter().map(|v| centre + rot.apply(*v)));
 }
@@ -44,7 +44,7 @@ pub fn place(polygon: &mut WorldPolygon, local: &[Vec2], (centre, angle): (Vec2,
 /// (to within `tolerance`), or `None` if it does not, or if it already is at t = 0 (then
 /// the two are in contact and the contact solver owns them). `radius` bounds the
 /// polygon's vertices about its centroid; `scratch` is a buffer.
-pub fn time_of_impact(
+pub(crate) fn time_of_impact(
     local: &[Vec2],
     radius: f64,
     sweep: &Sweep,
@@ -80,7 +80,7 @@ pub fn time_of_impact(
 /// which it is still no deeper than `depth`. This is where a contact solver that failed
 /// to hold it (a body dragged into a wall by something else) should have left it.
 /// `None` if it starts deeper than `depth`, or does not end deeper.
-pub fn time_of_sinking(
+pub(crate) fn time_of_sinking(
     local: &[Vec2],
     radius: f64,
     sweep: &Sweep,

@@ -7,14 +7,14 @@ use crate::math::{Vec2, clamp, cross, perp};
 /// The last solve's contact impulses by (body A, body B, feature), for warm starting the
 /// next: kept in contact order, which is by body pair as the broad phase lists pairs.
 #[derive(Debug, Clone, Default)]
-pub struct ContactMemory {
+pub(crate) struct ContactMemory {
     entries: Vec<Entry>,
 }
 
 impl ContactMemory {
     /// Writes each contact's impulses from `impulses` (by contact, normal and tangent)
     /// into it, and keeps them.
-    pub fn store_from(&mut self, contacts: &mut [Contact], impulses: &[(f64, f64)]) {
+    pub(crate) fn store_from(&mut self, contacts: &mut [Contact], impulses: &[(f64, f64)]) {
         self.entries.clear();
         self.entries.extend(
             contacts
@@ -28,7 +28,7 @@ impl ContactMemory {
     }
 
     /// Keeps the impulses the solve wrote into `contacts`.
-    pub fn store(&mut self, contacts: &[Contact]) {
+    pub(crate) fn store(&mut self, contacts: &[Contact]) {
         self.entries.clear();
         self.entries.extend(
             contacts
@@ -45,7 +45,7 @@ impl ContactMemory {
     /// entry found is the one `recall` finds. `None` says only that this guess missed
     /// (`recall` finds them all).
     #[inline]
-    pub fn guess(&self, k: usize, contact: &Contact) -> Option<(f64, f64)> {
+    pub(crate) fn guess(&self, k: usize, contact: &Contact) -> Option<(f64, f64)> {
         let key = key(contact);
         let own = |m: &&Entry| m.0 == key;
         let m = [k, k + 1, k.wrapping_sub(1)]
@@ -62,7 +62,7 @@ impl ContactMemory {
     /// entry found), then among its pair's entries, found a few entries on or else by a
     /// binary search. (Searched for contact by contact, in the islands' order, the smash's
     /// contacts, which come and go, spent a quarter of building their points searching.)
-    pub fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {
+    pub(crate) fn recall(&self, contacts: &[Contact], out: &mut Vec<(f64, f64)>) {
         /// How far on a pair's entries are looked for before a binary search.
         const SCAN: usize = 8;
         out.clear();
@@ -154,13 +154,13 @@ pub struct Contact {
 
 impl Contact {
     /// Whether the bodies meet during this step: touching already, or closing the gap.
-    pub fn meets_this_step(&self, dt: f64) -> bool {
+    pub(crate) fn meets_this_step(&self, dt: f64) -> bool {
         let gap = -self.depth;
         gap <= 0.0 || -self.normal_velocity * dt > gap
     }
 
     /// Whether the contact bounces: it meets this step, fast enough (SPEC §6.4).
-    pub fn bounces(&self, dt: f64, bounce_below: f64) -> bool {
+    pub(crate) fn bounces(&self, dt: f64, bounce_below: f64) -> bool {
         self.restitution > 0.0
             && self.meets_this_step(dt)
             && -self.approach_velocity >= bounce_below
@@ -171,7 +171,7 @@ impl Contact {
     /// further, touching bodies may not approach. (Stopping apart bodies where they are
     /// would leave a body hovering up to g·h² above the ground: 3 mm at 60 Hz, three body
     /// sizes for a 1 mm part.)
-    pub fn min_normal_velocity(&self, dt: f64, bounce_below: f64) -> f64 {
+    pub(crate) fn min_normal_velocity(&self, dt: f64, bounce_below: f64) -> f64 {
         if self.bounces(dt, bounce_below) {
             -self.restitution * self.approach_velocity.min(0.0)
         } else if self.depth < 0.0 {
@@ -181,19 +181,25 @@ impl Contact {
         }
     }
 
-    pub fn tangent(&self) -> Vec2 {
+    pub(crate) fn tangent(&self) -> Vec2 {
         perp(self.normal)
     }
 
     /// Velocity of A's point relative to B's, `v_AB` (SPEC eq. 2–3).
-    pub fn relative_velocity(&self, bodies: &[SolverBody]) -> Vec2 {
+    pub(crate) fn relative_velocity(&self, bodies: &[SolverBody]) -> Vec2 {
         let (a, b) = (&bodies[self.body_a as usize], &bodies[self.body_b as usize]);
         a.velocity_at(self.point) - b.velocity_at(self.point)
     }
 
     /// Velocity change along `d_out` at this contact from a unit impulse along `d_in` at
     /// `other` (+ on A, − on B): one entry of SPEC's `A_il` with signs (§3.2.2).
-    pub fn coupling(&self, d_out: Vec2, other: &Contact, d_in: Vec2, bodies: &[SolverBody]) -> f64 {
+    pub(crate) fn coupling(
+        &self,
+        d_out: Vec2,
+        other: &Contact,
+        d_in: Vec2,
+        bodies: &[SolverBody],
+    ) -> f64 {
         let mut sum = 0.0;
         for (body, s_out) in [(self.body_a, 1.0), (self.body_b, -1.0)] {
             for (other_body, s_in) in [(other.body_a, 1.0), (other.body_b, -1.0)] {
@@ -212,7 +218,12 @@ impl Contact {
     }
 
     /// Applies `j·n + t·n⊥` to A at the contact point and the opposite to B.
-    pub fn apply(&self, bodies: &mut [SolverBody], normal_impulse: f64, tangent_impulse: f64) {
+    pub(crate) fn apply(
+        &self,
+        bodies: &mut [SolverBody],
+        normal_impulse: f64,
+        tangent_impulse: f64,
+    ) {
         let impulse = self.normal * normal_impulse + self.tangent() * tangent_impulse;
         bodies[self.body_a as usize].apply_impulse(impulse, self.point);
         bodies[self.body_b as usize].apply_impulse(-impulse, self.point);
@@ -222,7 +233,7 @@ impl Contact {
 /// Two bodies' friction coefficients mixed for their contacts: the geometric mean. Equal
 /// coefficients (the usual case: both the world's) give that coefficient without a
 /// square root, with the same bits: in binary floating point sqrt(f·f) rounds to f.
-pub fn mixed_friction(a: f64, b: f64) -> f64 {
+pub(crate) fn mixed_friction(a: f64, b: f64) -> f64 {
     if a == b { a } else { geometric_mean(a, b) }
 }
 
@@ -236,14 +247,14 @@ fn geometric_mean(a: f64, b: f64) -> f64 {
 
 /// The speed below which contacts do not bounce: resting bodies would otherwise hop on the
 /// velocity gravity adds in one step (SPEC §6.4).
-pub fn restitution_threshold(gravity: Vec2, dt: f64) -> f64 {
+pub(crate) fn restitution_threshold(gravity: Vec2, dt: f64) -> f64 {
     2.0 * gravity.norm() * dt
 }
 
 /// SPEC §2.4.5's "separated" impulses: each contact alone, once, in order (eq. 15 and
 /// Coulomb friction of §2.4.4). Poor with several contacts — kept as the baseline the
 /// simultaneous solvers are measured against.
-pub fn solve_sequential(
+pub(crate) fn solve_sequential(
     contacts: &mut [Contact],
     bodies: &mut [SolverBody],
     dt: f64,

@@ -8,7 +8,7 @@
 /// The factor L of K = L Lᵀ, row by row within the envelope: row i holds columns
 /// `first[i]..=i`, from `l[start[i]]` on.
 #[derive(Debug, Clone, Default)]
-pub struct EnvelopeCholesky {
+pub(crate) struct EnvelopeCholesky {
     n: usize,
     first: Vec<usize>,
     start: Vec<usize>,
@@ -22,7 +22,7 @@ impl EnvelopeCholesky {
     /// Factors the symmetric `k` (row-major n × n; only its lower triangle is read).
     /// False if a pivot (L_ii²) is not above `min_pivot`: K is not positive definite, or
     /// too near singular to trust.
-    pub fn factor(&mut self, k: &[f64], n: usize, min_pivot: f64) -> bool {
+    pub(crate) fn factor(&mut self, k: &[f64], n: usize, min_pivot: f64) -> bool {
         debug_assert_eq!(k.len(), n * n);
         self.n = n;
         self.first.clear();
@@ -72,7 +72,7 @@ impl EnvelopeCholesky {
     }
 
     /// Solves K x = b in place with the last successful `factor`.
-    pub fn solve(&self, b: &mut [f64]) {
+    pub(crate) fn solve(&self, b: &mut [f64]) {
         let n = self.n;
         debug_assert_eq!(b.len(), n);
         // L y = b, row by row.
@@ -104,7 +104,7 @@ impl EnvelopeCholesky {
 /// turned a step ahead: nearly symmetric and positive definite, so pivoting is not needed,
 /// and a pivot that comes out small says so (`factor` is false; solve densely then).
 #[derive(Debug, Clone, Default)]
-pub struct EnvelopeLu {
+pub(crate) struct EnvelopeLu {
     n: usize,
     first: Vec<usize>,
     start: Vec<usize>,
@@ -116,7 +116,7 @@ pub struct EnvelopeLu {
 impl EnvelopeLu {
     /// Factors `k` (row-major n × n). False if a pivot's magnitude is not above
     /// `min_pivot`.
-    pub fn factor(&mut self, k: &[f64], n: usize, min_pivot: f64) -> bool {
+    pub(crate) fn factor(&mut self, k: &[f64], n: usize, min_pivot: f64) -> bool {
         debug_assert_eq!(k.len(), n * n);
         self.n = n;
         self.first.clear();
@@ -171,7 +171,7 @@ impl EnvelopeLu {
     }
 
     /// Solves K x = b in place with the last successful `factor`.
-    pub fn solve(&self, b: &mut [f64]) {
+    pub(crate) fn solve(&self, b: &mut [f64]) {
         let n = self.n;
         debug_assert_eq!(b.len(), n);
         for i in 0..n {

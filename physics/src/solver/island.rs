@@ -3,7 +3,7 @@
 
 /// Union–find over body slots with path halving; deterministic.
 #[derive(Debug, Clone, Default)]
-pub struct UnionFind {
+pub(crate) struct UnionFind {
     parent: Vec<u32>,
     /// `group_by_island`'s counting sort by root (`counting_sort`'s scratch).
     starts: Vec<u32>,
@@ -12,12 +12,12 @@ pub struct UnionFind {
 }
 
 impl UnionFind {
-    pub fn reset(&mut self, n: usize) {
+    pub(crate) fn reset(&mut self, n: usize) {
         self.parent.clear();
         self.parent.extend(0..n as u32);
     }
 
-    pub fn find(&mut self, mut i: u32) -> u32 {
+    pub(crate) fn find(&mut self, mut i: u32) -> u32 {
         while self.parent[i as usize] != i {
             let grand = self.parent[self.parent[i as usize] as usize];
             self.parent[i as usize] = grand;
@@ -28,7 +28,7 @@ impl UnionFind {
 
     /// Joins the sets of `a` and `b`; the smaller root wins, so results do not depend on
     /// the order of unions.
-    pub fn union(&mut self, a: u32, b: u32) {
+    pub(crate) fn union(&mut self, a: u32, b: u32) {
         let (ra, rb) = (self.find(a), self.find(b));
         if ra != rb {
             let (lo, hi) = (ra.min(rb), ra.max(rb));
@@ -40,7 +40,7 @@ impl UnionFind {
 /// Groups items (constraints) into islands. `ends(i)` gives the two body slots of item `i`
 /// and `dynamic(slot)` says whether a body connects. Returns `(island key, item)` pairs
 /// sorted by island and then item, so each island's items keep their original order.
-pub fn group_by_island(
+pub(crate) fn group_by_island(
     count: usize,
     bodies: usize,
     ends: impl Fn(usize) -> (u32, u32),
@@ -87,7 +87,7 @@ pub fn group_by_island(
 /// `group_by_island` with its last result kept: a pile at rest has the same contacts,
 /// between the same bodies, step after step, and then the islands are those it found.
 #[derive(Debug, Clone, Default)]
-pub struct IslandGrouping {
+pub(crate) struct IslandGrouping {
     uf: UnionFind,
     /// The last call's item ends and which bodies connected.
     ends: Vec<(u32, u32)>,
@@ -100,13 +100,13 @@ pub struct IslandGrouping {
 impl IslandGrouping {
     /// Whether the last `group` found the same items and bodies as the call before it, and
     /// so returned the grouping it had: what a caller planned from that grouping stands.
-    pub fn kept(&self) -> bool {
+    pub(crate) fn kept(&self) -> bool {
         self.kept
     }
 
     /// `group_by_island`'s result for these items, found again only if an item's ends or
     /// a body's `dynamic` differ from the last call's.
-    pub fn group(
+    pub(crate) fn group(
         &mut self,
         count: usize,
         bodies: usize,
@@ -143,7 +143,7 @@ impl IslandGrouping {
     /// every item's ends with those before it relies on the grouping, and call `group` if
     /// any differs; `kept` says true until then. (Checking them here would read every item
     /// once more: the big piles' contacts are 3 MB, and their points read each one anyway.)
-    pub fn bodies_kept(
+    pub(crate) fn bodies_kept(
         &mut self,
         count: usize,
         bodies: usize,
@@ -160,19 +160,19 @@ impl IslandGrouping {
     }
 
     /// The last call's result: `(island key, item)` pairs, as `group` returned them.
-    pub fn grouped(&self) -> &[(u32, u32)] {
+    pub(crate) fn grouped(&self) -> &[(u32, u32)] {
         &self.grouped
     }
 
     /// The last call's items' ends, by item.
-    pub fn ends(&self) -> &[(u32, u32)] {
+    pub(crate) fn ends(&self) -> &[(u32, u32)] {
         &self.ends
     }
 }
 
 /// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
 /// is scratch, kept by the caller so that a step allocates nothing.
-pub fn counting_sort<T: Copy>(
+pub(crate) fn counting_sort<T: Copy>(
     items: &[T],
     keys: usize,
     key: impl Fn(&T) -> usize,

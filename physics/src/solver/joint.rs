@@ -9,14 +9,14 @@ use nalgebra::{DMatrix, DVector};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
 /// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (SPEC §3.3).
-pub const DIRECT_JOINT_LIMIT: usize = 256;
+pub(crate) const DIRECT_JOINT_LIMIT: usize = 256;
 
 /// A joint's handle in its world. Handles are never reused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct JointHandle(pub u32);
 
 impl JointHandle {
-    pub fn index(self) -> usize {
+    pub(crate) fn index(self) -> usize {
         self.0 as usize
     }
 }
@@ -39,7 +39,7 @@ pub struct Joint {
 /// A joint as the solver sees it: body slots in the step's solver array (the static world
 /// is the slot past the last body) and the anchors.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JointConstraint {
+pub(crate) struct JointConstraint {
     pub joint: u32,
     pub body_a: u32,
     pub body_b: u32,
@@ -67,7 +67,7 @@ pub struct JointMotor {
 
 impl JointMotor {
     /// Both numbers finite and within `crate::limits`, the torque bound non-negative.
-    pub fn validate(&self) -> Result<(), super::motor::MotorError> {
+    pub(crate) fn validate(&self) -> Result<(), super::motor::MotorError> {
         use super::motor::MotorError;
         if !self.target_speed.is_finite() {
             return Err(MotorError::NonFinite("target speed", self.target_speed));
@@ -101,7 +101,7 @@ impl JointMotor {
 
 /// How hard the joint passes iterate (SPEC §3.3 Rec: Gauss–Seidel with a tolerance and a cap).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JointIterations {
+pub(crate) struct JointIterations {
     /// Stop once every predicted gap is below this (length units).
     pub position_tolerance: f64,
     /// Stop once every relative anchor speed is below this (length units per second).
@@ -146,13 +146,13 @@ fn solve_2x2(k: [[f64; 2]; 2], rhs: Vec2) -> Option<Vec2> {
 
 impl JointConstraint {
     /// World anchor offsets from each centroid, `r_A` and `r_B`.
-    pub fn arms(&self, angles: (f64, f64)) -> (Vec2, Vec2) {
+    pub(crate) fn arms(&self, angles: (f64, f64)) -> (Vec2, Vec2) {
         self.arms_turned((Rot::new(angles.0), Rot::new(angles.1)))
     }
 
     /// `arms` for bodies turned by the given rotations (found once per body, where the
     /// bodies carry many pins).
-    pub fn arms_turned(&self, (a, b): (Rot, Rot)) -> (Vec2, Vec2) {
+    pub(crate) fn arms_turned(&self, (a, b): (Rot, Rot)) -> (Vec2, Vec2) {
         (a.apply(self.local_anchor_a), b.apply(self.local_anchor_b))
     }
 
@@ -172,7 +172,7 @@ impl JointConstraint {
     }
 
     /// Where the anchors would be after integrating the current velocities for `dt`.
-    pub fn predicted_gap(&self, bodies: &[SolverBody], dt: f64) -> Vec2 {
+    pub(crate) fn predicted_gap(&self, bodies: &[SolverBody], dt: f64) -> Vec2 {
         let end = |i: usize, local: Vec2| {
             let b = &bodies[i];
             b.position + b.velocity * dt + Rot::new(b.angle + b.angular_velocity * dt).apply(local)
@@ -200,7 +200,7 @@ impl JointConstraint {
 }
 
 /// Start of step: every joint's anchors stop drifting apart (SPEC §3.3 eq. 40), iterated.
-pub fn correct_velocities(
+pub(crate) fn correct_velocities(
     joints: &[JointConstraint],
     bodies: &mut [SolverBody],
     it: &JointIterations,
@@ -219,7 +219,7 @@ pub fn correct_velocities(
 
 /// After contacts: impulses that make every joint's anchors meet at the end of the step
 /// (SPEC §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
-pub fn correct_positions(
+pub(crate) fn correct_positions(
     joints: &[JointConstraint],
     bodies: &mut [SolverBody],
     dt: f64,
@@ -239,7 +239,7 @@ pub fn correct_positions(
 
 /// What a joint's gap should be at the end of this step: closed, or `max_closing` narrower
 /// if it is wider than that now.
-pub fn gap_target(gap_now: Vec2, max_closing: f64) -> Vec2 {
+pub(crate) fn gap_target(gap_now: Vec2, max_closing: f64) -> Vec2 {
     let len = gap_now.norm();
     if len > max_closing {
         gap_now * (1.0 - max_closing / len)
@@ -251,7 +251,7 @@ pub fn gap_target(gap_now: Vec2, max_closing: f64) -> Vec2 {
 /// What the velocity passes aim a joint's predicted gap at: closed for a healthy joint
 /// (the thesis method, SPEC §3.3), held where it is for a broken one, which only the
 /// position repair closes.
-pub fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
+pub(crate) fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
     if gap_now.norm() > broken_gap {
         gap_now
     } else {
@@ -260,18 +260,9 @@ pub fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
 }
 
 /// Joint motors as bounded velocity constraints, solved by projected Gauss–Seidel on the
-/// accumulated impulse so the bound ±max_torque·h holds over the whole step.
-pub fn drive_motors(
-    joints: &mut [JointConstraint],
-    bodies: &mut [SolverBody],
-    dt: f64,
-    sweeps: usize,
-) {
-    drive_motors_continue(joints, bodies, dt, sweeps, true);
-}
-
-/// Like [`drive_motors`], optionally keeping the impulses already applied this step so the
-/// bound holds over several rounds.
+/// accumulated impulse so the bound ±max_torque·h holds over the whole step; unless
+/// `fresh`, keeping the impulses already applied this step so the bound holds over several
+/// rounds.
 fn drive_motors_continue(
     joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
@@ -311,11 +302,6 @@ fn drive_motors_continue(
     }
 }
 
-/// Distance between a joint's two anchors now.
-pub fn gap(joint: &JointConstraint, bodies: &[SolverBody]) -> f64 {
-    joint.predicted_gap(bodies, 0.0).norm()
-}
-
 /// How the joint passes solve the coupled joints of an island.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum JointSolver {
@@ -328,7 +314,7 @@ pub enum JointSolver {
 
 /// Buffers for solving joints island by island, reused across steps.
 #[derive(Debug, Clone, Default)]
-pub struct JointBlockSolver {
+pub(crate) struct JointBlockSolver {
     uf: UnionFind,
     grouped: Vec<(u32, u32)>,
     island: Vec<JointConstraint>,
@@ -726,7 +712,7 @@ impl JointBlockSolver {
     /// pulled up to `max_closing` closer by moving the bodies of its island, which adds no
     /// kinetic energy — a stretched chain snaps together instead of whipping. Does
     /// nothing (and costs one pass over the joints) when no joint is broken.
-    pub fn repair_positions(
+    pub(crate) fn repair_positions(
         &mut self,
         solver: JointSolver,
         joints: &mut [JointConstraint],
@@ -757,7 +743,7 @@ impl JointBlockSolver {
     }
 
     /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
-    pub fn correct_velocities(
+    pub(crate) fn correct_velocities(
         &mut self,
         solver: JointSolver,
         joints: &mut [JointConstraint],
@@ -779,7 +765,7 @@ impl JointBlockSolver {
     /// Stage 6 (SPEC §3.3): motors, then Newton steps on the predicted gaps until every
     /// joint closes. Motors and joints alternate so that both hold at the end;
     /// `motors_started` says the motors' impulses of this step so far are in place.
-    pub fn correct_positions(
+    pub(crate) fn correct_positions(
         &mut self,
         solver: JointSolver,
         joints: &mut [JointConstraint],

@@ -21,7 +21,7 @@ use crate::math::clamp;
 
 /// One problem. `a` is row-major `n×n`.
 #[derive(Debug, Clone, Copy)]
-pub struct LcpProblem<'a> {
+pub(crate) struct LcpProblem<'a> {
     pub n: usize,
     pub a: &'a [f64],
     pub b: &'a [f64],
@@ -39,14 +39,14 @@ pub struct LcpProblem<'a> {
 /// A friction row's bounds: `±μ` times the impulse of one normal row, or of two summed
 /// (one friction row for both points of a face contact).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FrictionBound {
+pub(crate) struct FrictionBound {
     pub mu: f64,
     pub normal: usize,
     pub second_normal: Option<usize>,
 }
 
 impl FrictionBound {
-    pub fn single(normal: usize, mu: f64) -> Self {
+    pub(crate) fn single(normal: usize, mu: f64) -> Self {
         Self {
             mu,
             normal,
@@ -54,7 +54,7 @@ impl FrictionBound {
         }
     }
 
-    pub fn shared(normal: usize, second_normal: usize, mu: f64) -> Self {
+    pub(crate) fn shared(normal: usize, second_normal: usize, mu: f64) -> Self {
         Self {
             mu,
             normal,
@@ -63,7 +63,7 @@ impl FrictionBound {
     }
 
     /// `μ` times the (non-negative part of the) normal impulses, given each row's impulse.
-    pub fn bound(&self, impulse: impl Fn(usize) -> f64) -> f64 {
+    pub(crate) fn bound(&self, impulse: impl Fn(usize) -> f64) -> f64 {
         let second = self.second_normal.map_or(0.0, |k| impulse(k).max(0.0));
         self.mu * (impulse(self.normal).max(0.0) + second)
     }
@@ -71,7 +71,7 @@ impl FrictionBound {
 
 /// How a problem was solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LcpMethod {
+pub(crate) enum LcpMethod {
     #[default]
     Pivoting,
     ProjectedGaussSeidel,
@@ -80,7 +80,7 @@ pub enum LcpMethod {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct LcpStats {
+pub(crate) struct LcpStats {
     pub method: LcpMethod,
     pub pivots: usize,
     /// Friction-index rounds: all of them, and those solved by keeping the last round's
@@ -106,7 +106,7 @@ enum Set {
 
 /// Reusable buffers: solving allocates only when a problem is bigger than any before.
 #[derive(Debug, Clone, Default)]
-pub struct LcpSolver {
+pub(crate) struct LcpSolver {
     scale: Vec<f64>,
     a: Vec<f64>,
     b: Vec<f64>,
@@ -135,7 +135,7 @@ pub struct LcpSolver {
 /// to the factor alone, a solve with the last sets disagreed with the pivoting that found
 /// them, and every friction round pivoted again (the overlap-recovery pyramid: 2,900
 /// pivots a step instead of 300).
-pub const REGULARISATION: f64 = 1e-12;
+pub(crate) const REGULARISATION: f64 = 1e-12;
 /// Friction-index rounds before giving up on a fixed point, and the relative change of
 /// the impulses at which they stop.
 const FRICTION_ROUNDS: usize = 30;
@@ -164,14 +164,19 @@ const CHECK_TOLERANCE: f64 = 1e-9;
 
 impl LcpSolver {
     /// Solves by pivoting (falling back to Gauss–Seidel if pivoting fails) into `x`.
-    pub fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+    pub(crate) fn solve(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
         self.solve_guessing(p, &[], x)
     }
 
     /// `solve`, with the friction rows' first bounds taken from `guess` (say, the last
     /// step's impulses) instead of from zero, so that the rounds start near the fixed
     /// point. An empty `guess` is zero.
-    pub fn solve_guessing(&mut self, p: &LcpProblem, guess: &[f64], x: &mut Vec<f64>) -> LcpStats {
+    pub(crate) fn solve_guessing(
+        &mut self,
+        p: &LcpProblem,
+        guess: &[f64],
+        x: &mut Vec<f64>,
+    ) -> LcpStats {
         let mut stats = self.solve_from(p, x, false, guess);
         if stats.method != LcpMethod::Rejected {
             stats.residual = complementarity_residual(p, x);
@@ -184,7 +189,7 @@ impl LcpSolver {
     /// solution's sets and the factor of their `A_CC`, and pivots only if they do not
     /// solve it. The residual is not computed: it took 3% of the soft step's time in the
     /// random throws (`physics/tests/support/random_throws.rs`).
-    pub fn solve_again(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
+    pub(crate) fn solve_again(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
         let warm = self.sets_valid && self.b.len() == p.n;
         self.solve_from(p, x, warm, &[])
     }
@@ -741,7 +746,7 @@ enum Event {
 
 /// The largest violation of `lo ≤ x ≤ hi` and of complementarity, relative to
 /// `max|b| + max|A|·max|x|` (the size of the terms that make up `w`).
-pub fn complementarity_residual(p: &LcpProblem, x: &[f64]) -> f64 {
+pub(crate) fn complementarity_residual(p: &LcpProblem, x: &[f64]) -> f64 {
     let n = p.n;
     let amax = p.a[..n * n].iter().map(|v| v.abs()).fold(0.0, f64::max);
     let xmax = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
@@ -772,3 +777,6 @@ pub fn complementarity_residual(p: &LcpProblem, x: &[f64]) -> f64 {
     }
     worst
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,21 +1,21 @@
 //! Constraint solvers: contacts, the boxed LCP, joints and motors.
 
-pub mod contact;
-pub mod envelope;
-pub mod island;
-pub mod joint;
-pub mod lcp;
-pub mod motor;
-pub mod simultaneous;
-pub mod soft;
-pub mod system;
+pub(crate) mod contact;
+pub(crate) mod envelope;
+pub(crate) mod island;
+pub(crate) mod joint;
+pub(crate) mod lcp;
+pub(crate) mod motor;
+pub(crate) mod simultaneous;
+pub(crate) mod soft;
+pub(crate) mod system;
 
 use crate::body::Body;
 use crate::math::{Vec2, cross, cross_scalar};
 
 /// What a solver needs of a body: its velocity, inverse mass and where its centroid is.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SolverBody {
+pub(crate) struct SolverBody {
     pub velocity: Vec2,
     pub angular_velocity: f64,
     pub inv_mass: f64,
@@ -25,7 +25,7 @@ pub struct SolverBody {
 }
 
 impl SolverBody {
-    pub fn from_body(body: &Body) -> Self {
+    pub(crate) fn from_body(body: &Body) -> Self {
         Self {
             velocity: body.velocity,
             angular_velocity: body.angular_velocity,
@@ -36,11 +36,11 @@ impl SolverBody {
         }
     }
 
-    pub fn velocity_at(&self, point: Vec2) -> Vec2 {
+    pub(crate) fn velocity_at(&self, point: Vec2) -> Vec2 {
         self.velocity + cross_scalar(self.angular_velocity, point - self.position)
     }
 
-    pub fn apply_impulse(&mut self, impulse: Vec2, point: Vec2) {
+    pub(crate) fn apply_impulse(&mut self, impulse: Vec2, point: Vec2) {
         self.velocity += impulse * self.inv_mass;
         self.angular_velocity += self.inv_inertia * cross(point - self.position, impulse);
     }

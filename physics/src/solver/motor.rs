@@ -50,7 +50,7 @@ impl BodyMotor {
 
     /// Refuses what would put a non-finite torque into the world: every number must be
     /// finite and the torques and their increase non-negative.
-    pub fn validate(&self) -> Result<(), MotorError> {
+    pub(crate) fn validate(&self) -> Result<(), MotorError> {
         let fields = [
             ("angular", self.angular),
             ("start torque", self.start_torque),
@@ -81,13 +81,13 @@ impl BodyMotor {
     }
 
     /// Whether step `step` lies in the motor's window `time0 ≤ t < time1`.
-    pub fn is_on(&self, step: u64) -> bool {
+    pub(crate) fn is_on(&self, step: u64) -> bool {
         (self.time0..self.time1).contains(&step)
     }
 
     /// The signed torque for step `step` given the body's angular velocity `omega` (rad/s)
     /// and the step `dt`, advancing the ramp.
-    pub fn torque(&mut self, step: u64, omega: f64, dt: f64) -> f64 {
+    pub(crate) fn torque(&mut self, step: u64, omega: f64, dt: f64) -> f64 {
         if !self.is_on(step) {
             self.current = 0.0;
             return 0.0;

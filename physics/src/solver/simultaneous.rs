@@ -14,7 +14,7 @@ use crate::math::clamp;
 /// dense pivoting method, whose cost grows as n³. Measured by `examples/dense_threshold.rs`
 /// (README, Physics): where the pivoting solve starts costing more than the whole rest of
 /// a step.
-pub const DENSE_ROW_LIMIT: usize = 96;
+pub(crate) const DENSE_ROW_LIMIT: usize = 96;
 
 /// The position pass's regularisation (`lcp::LcpProblem`): it moves bodies apart, where
 /// a compliance of 1e-9 changes nothing visible, and stacked boxes pressed into each other
@@ -62,7 +62,7 @@ pub struct IslandReport {
 
 /// The two-stage thesis pipeline or the coupled one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FrictionModel {
+pub(crate) enum FrictionModel {
     /// SPEC §3.2.4 steps 1–6: normals without friction, then friction bounded by them.
     TwoStage,
     /// Normals, friction (bounds ±μ·normal, updated with it), pins and motors together.
@@ -71,7 +71,7 @@ pub enum FrictionModel {
 
 /// Buffers reused across steps.
 #[derive(Debug, Clone, Default)]
-pub struct SimultaneousSolver {
+pub(crate) struct SimultaneousSolver {
     uf: UnionFind,
     grouped: Vec<(u32, u32)>,
     /// Each island's span of `grouped`.
@@ -117,7 +117,7 @@ impl SimultaneousSolver {
     /// Solves every island and applies the impulses to `bodies`; contacts get their normal
     /// and tangent impulses, joints with motors their motor impulse. With `TwoStage`,
     /// joints are left to the joint passes, as in the thesis.
-    pub fn solve(
+    pub(crate) fn solve(
         &mut self,
         model: FrictionModel,
         contacts: &mut [Contact],
@@ -160,7 +160,7 @@ impl SimultaneousSolver {
     /// normal rows, with the pins as equality rows so the push cannot open them, are solved
     /// for pseudo-velocities that move `bodies`' positions and angles only. Each step
     /// removes the fraction `rate` of the excess depth.
-    pub fn separate(
+    pub(crate) fn separate(
         &mut self,
         contacts: &[Contact],
         joints: &[JointConstraint],

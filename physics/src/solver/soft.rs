@@ -50,7 +50,7 @@ const DIRECT_JOINT_LIMIT: usize = 64;
 
 /// Tuning of the soft step; defaults after Box2D v3, scaled by the world's length scale.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SoftSettings {
+pub(crate) struct SoftSettings {
     pub substeps: usize,
     /// Contact stiffness (Hz), capped at a quarter of the substep rate for stability;
     /// twice as stiff against a fixed body (as Box2D v3), which holds a pile up from
@@ -72,7 +72,7 @@ pub struct SoftSettings {
 }
 
 impl SoftSettings {
-    pub fn for_length_scale(length_scale: f64) -> Self {
+    pub(crate) fn for_length_scale(length_scale: f64) -> Self {
         Self {
             substeps: 4,
             contact_hertz: 30.0,
@@ -393,7 +393,7 @@ impl JointMemory {
 
 /// Warm-start memory and buffers, kept between steps.
 #[derive(Debug, Clone, Default)]
-pub struct SoftStepSolver {
+pub(crate) struct SoftStepSolver {
     bodies: Vec<SoftBody>,
     points: Vec<PointConstraint>,
     joints: Vec<SoftJoint>,
@@ -610,7 +610,7 @@ impl SoftStepSolver {
     /// Advances `bodies` by `dt`: velocities from `accelerations` (linear, angular per
     /// body), constraints from `contacts` and `joints`, positions and angles integrated.
     #[allow(clippy::too_many_arguments)]
-    pub fn step(
+    pub(crate) fn step(
         &mut self,
         settings: &SoftSettings,
         bodies: &mut [SolverBody],

@@ -12,7 +12,7 @@ use crate::math::{Vec2, cross};
 
 /// One body's part of a row: the row's velocity is `linear·v + angular·ω` summed over both.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct RowEnd {
+pub(crate) struct RowEnd {
     pub body: u32,
     pub linear: Vec2,
     pub angular: f64,
@@ -20,7 +20,7 @@ pub struct RowEnd {
 
 /// What a row stands for, to put its impulse back where it belongs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RowKind {
+pub(crate) enum RowKind {
     ContactNormal(u32),
     ContactTangent(u32),
     /// The one friction row of a face contact's two points (see `velocity_rows`).
@@ -31,7 +31,7 @@ pub enum RowKind {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Row {
+pub(crate) struct Row {
     pub kind: RowKind,
     pub ends: [RowEnd; 2],
     pub b: f64,
@@ -42,7 +42,7 @@ pub struct Row {
 }
 
 impl Row {
-    pub fn velocity(&self, bodies: &[SolverBody]) -> f64 {
+    pub(crate) fn velocity(&self, bodies: &[SolverBody]) -> f64 {
         self.ends
             .iter()
             .map(|e| {
@@ -53,7 +53,7 @@ impl Row {
     }
 
     /// How much a unit impulse along the row changes the row's own velocity: `A_ii`.
-    pub fn diagonal(&self, bodies: &[SolverBody]) -> f64 {
+    pub(crate) fn diagonal(&self, bodies: &[SolverBody]) -> f64 {
         self.ends
             .iter()
             .map(|e| {
@@ -64,7 +64,7 @@ impl Row {
     }
 
     /// Applies impulse `x` along the row (its Jacobian transposed, scaled by M⁻¹).
-    pub fn apply(&self, bodies: &mut [SolverBody], x: f64) {
+    pub(crate) fn apply(&self, bodies: &mut [SolverBody], x: f64) {
         for e in &self.ends {
             let t = &mut bodies[e.body as usize];
             t.velocity += e.linear * (x * t.inv_mass);
@@ -100,7 +100,7 @@ fn point_row(
 
 /// What the velocity rows aim for.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VelocityTargets {
+pub(crate) struct VelocityTargets {
     pub dt: f64,
     /// Approach speeds below this do not bounce.
     pub bounce_below: f64,
@@ -112,7 +112,7 @@ pub struct VelocityTargets {
 }
 
 /// Builds the velocity-level rows of one island.
-pub fn velocity_rows(
+pub(crate) fn velocity_rows(
     contacts: &[(u32, Contact)],
     joints: &[JointConstraint],
     bodies: &[SolverBody],
@@ -228,7 +228,7 @@ pub fn velocity_rows(
 }
 
 /// Fills the dense symmetric `A = J M⁻¹ Jᵀ` (row-major, n×n) of `rows`.
-pub fn assemble(rows: &[Row], bodies: &[SolverBody], a: &mut Vec<f64>) {
+pub(crate) fn assemble(rows: &[Row], bodies: &[SolverBody], a: &mut Vec<f64>) {
     let n = rows.len();
     a.clear();
     a.resize(n * n, 0.0);

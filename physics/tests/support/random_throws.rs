@@ -19,8 +19,9 @@
 // Each user takes what it needs of this file.
 #![allow(dead_code)]
 
-use pe::collide::{WorldPolygon, collide_polygons};
-use pe::{BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Rot, Vec2, World};
+use pe::{
+    BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Vec2, World, WorldPolygon, collide_polygons,
+};
 use std::collections::{HashMap, HashSet};
 use std::time::{Duration, Instant};
 
@@ -267,9 +268,11 @@ impl Judge {
         self.energy.after_step(&self.states);
         self.polygons.truncate(WALLS.len());
         for ((vertices, _), state) in self.shapes.iter().zip(&self.states) {
-            let turn = Rot::new(state.angle);
+            // R(θ)·v, the rotation pe places a body's vertices by.
+            let (sin, cos) = state.angle.sin_cos();
+            let turn = |v: Vec2| Vec2::new(cos * v.x - sin * v.y, sin * v.x + cos * v.y);
             let mut polygon = WorldPolygon::default();
-            polygon.set_vertices(vertices.iter().map(|&v| state.at + turn.apply(v)));
+            polygon.set_vertices(vertices.iter().map(|&v| state.at + turn(v)));
             self.polygons.push(polygon);
         }
         self.before.clear();

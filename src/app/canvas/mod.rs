@@ -11,8 +11,7 @@ use super::tools::Tool;
 use super::world_bound::WorldBound;
 use crate::sim::Simulation;
 use egui::{Color32, PointerButton, Rect, Sense, Stroke};
-use pe::collide::Aabb;
-use pe::{BodyHandle, Vec2};
+use pe::{Aabb, BodyHandle, Vec2};
 
 /// Which overlays to draw.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -483,7 +482,7 @@ fn covers(sim: &Simulation, i: usize, p: Vec2) -> bool {
     let verts: Vec<Vec2> = body.world_vertices().collect();
     let side = |k: usize| {
         let (a, c) = (verts[k], verts[(k + 1) % verts.len()]);
-        pe::math::cross(c - a, p - a)
+        (c - a).perp(&(p - a))
     };
     (0..verts.len()).all(|k| side(k) >= 0.0) || (0..verts.len()).all(|k| side(k) <= 0.0)
 }

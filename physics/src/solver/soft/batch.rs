@@ -90,7 +90,7 @@ pub(super) enum AskedFor {
 
 impl BatchesAhead {
     /// The same, asking only if `ask` too.
-    pub fn only_if(mut self, ask: bool) -> Self {
+    pub(crate) fn only_if(mut self, ask: bool) -> Self {
         self.on &= ask;
         self
     }
@@ -98,7 +98,7 @@ impl BatchesAhead {
     /// Hands `items` to `visit` in their order, asking for what `reader` will read of
     /// each next one's batch while the one before is visited.
     #[inline(always)]
-    pub fn visit<'a>(
+    pub(crate) fn visit<'a>(
         self,
         items: impl Iterator<Item = &'a PassItem>,
         reader: AskedFor,
@@ -286,7 +286,7 @@ impl PlanInput {
     const SIDEWAYS: u32 = 16;
 
     /// A one-point manifold (so far) between `a` and `b`, whose point is `first`.
-    pub fn new(
+    pub(crate) fn new(
         (a, b): (u32, u32),
         first: usize,
         (a_moves, b_moves): (bool, bool),
@@ -304,13 +304,13 @@ impl PlanInput {
     }
 
     /// The manifold's next point is coupled with its first: a two-point manifold.
-    pub fn add_second_point(&mut self) {
+    pub(crate) fn add_second_point(&mut self) {
         self.flags |= Self::TWO_POINTS;
     }
 
     /// Tests only: the manifold's first point and its count of points.
     #[cfg(test)]
-    pub fn first_and_count(self) -> (u32, u32) {
+    pub(crate) fn first_and_count(self) -> (u32, u32) {
         (self.first, self.count())
     }
 
@@ -328,7 +328,7 @@ impl PassPlan {
     /// (index ranges of the points, and whether the island is solved as one LCP: those
     /// are left out). Whether they are the last plan's: then `plan` keeps it.
     /// `pinned` says, by body, whether a pin joins it (bodies past its end carry none).
-    pub fn read(
+    pub(crate) fn read(
         &mut self,
         islands: &[(usize, usize, bool)],
         manifolds: &[PlanInput],
@@ -341,7 +341,7 @@ impl PassPlan {
     }
 
     /// Plans the passes over `points`, for the manifolds last `read`.
-    pub fn plan(&mut self, points: &[PointConstraint], bodies: &[SoftBody]) {
+    pub(crate) fn plan(&mut self, points: &[PointConstraint], bodies: &[SoftBody]) {
         let filled_while_built = std::mem::take(&mut self.filled_while_built);
         if self.kept_last_step {
             // A pile at rest: the same manifolds between the same bodies.
@@ -362,7 +362,7 @@ impl PassPlan {
     /// their entries alone: each manifold then goes into its lane, in the kept plan or in
     /// a new one, as its points are built (`fill_manifold`). The entries read must be
     /// those the points will make (`SoftStepSolver::plan_from_contacts` finds them).
-    pub fn plan_before_points(&mut self, point_count: usize, bodies: &[SoftBody]) {
+    pub(crate) fn plan_before_points(&mut self, point_count: usize, bodies: &[SoftBody]) {
         if !self.kept_last_step {
             self.make(None, point_count, bodies);
         }
@@ -370,7 +370,7 @@ impl PassPlan {
     }
 
     /// Whether the last step kept the plan before it (until this step's `read`).
-    pub fn kept_last_step(&self) -> bool {
+    pub(crate) fn kept_last_step(&self) -> bool {
         self.kept_last_step
     }
 
@@ -491,20 +491,20 @@ impl PassPlan {
     /// are built (`fill_manifold`), if the last step kept its plan. If the plan turns out
     /// to change, `plan` makes and fills the new one as usual; if it is kept after a
     /// change, `plan` fills it from the points.
-    pub fn begin_filling(&mut self) {
+    pub(crate) fn begin_filling(&mut self) {
         self.filled_while_built = self.kept_last_step;
     }
 
     /// Fills no more lanes while the points are built: `plan` fills them (the points
     /// are being built again, all written, for a plan that changed after all).
-    pub fn stop_filling(&mut self) {
+    pub(crate) fn stop_filling(&mut self) {
         self.filled_while_built = false;
     }
 
     /// The manifold of points `manifold` whose first point is `first`, just built, into
     /// the lane the kept plan has for it, if any and of its size: whether it went into one.
     #[inline(always)]
-    pub fn fill_manifold<const N: usize>(
+    pub(crate) fn fill_manifold<const N: usize>(
         &mut self,
         first: usize,
         manifold: &[PointConstraint; N],
@@ -655,12 +655,12 @@ impl PassPlan {
     }
 
     /// How many chunks the coloured islands are solved in (`assign_chunks`).
-    pub fn chunk_count(&self) -> usize {
+    pub(crate) fn chunk_count(&self) -> usize {
         self.chunk_starts.len().saturating_sub(1)
     }
 
     /// The rest's items: every item but the chunks'.
-    pub fn rest_items(&self) -> std::ops::Range<usize> {
+    pub(crate) fn rest_items(&self) -> std::ops::Range<usize> {
         0..self
             .chunk_starts
             .first()
@@ -669,18 +669,18 @@ impl PassPlan {
     }
 
     /// The items of chunk `k` (from 0), and its moving bodies.
-    pub fn chunk(&self, k: usize) -> (std::ops::Range<usize>, &[u32]) {
+    pub(crate) fn chunk(&self, k: usize) -> (std::ops::Range<usize>, &[u32]) {
         let bodies = &self.chunk_bodies[self.chunk_body_starts[k]..self.chunk_body_starts[k + 1]];
         (self.chunk_starts[k]..self.chunk_starts[k + 1], bodies)
     }
 
     /// Whether a chunk moves `body` (then the rest's passes leave it).
-    pub fn in_chunk(&self, body: usize) -> bool {
+    pub(crate) fn in_chunk(&self, body: usize) -> bool {
         self.in_chunk.get(body).copied().unwrap_or(false)
     }
 
     /// Writes what the passes changed in the batches back to their points.
-    pub fn scatter(&self, points: &mut [PointConstraint]) {
+    pub(crate) fn scatter(&self, points: &mut [PointConstraint]) {
         for batch in self.batches() {
             batch.scatter(points);
         }
@@ -691,7 +691,7 @@ impl PassPlan {
 
     /// The batches' accumulated impulses, into `impulses` (normal and tangent, by
     /// contact).
-    pub fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
+    pub(crate) fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
         for batch in self.batches() {
             batch.store_impulses(impulses);
         }
@@ -701,19 +701,19 @@ impl PassPlan {
     }
 
     /// The step's batches of two-point manifolds.
-    pub fn batches(&self) -> &[ManifoldBatch<2>] {
+    pub(crate) fn batches(&self) -> &[ManifoldBatch<2>] {
         self.pairs.filled()
     }
 
     /// The step's batches of one-point manifolds.
-    pub fn point_batches(&self) -> &[ManifoldBatch<1>] {
+    pub(crate) fn point_batches(&self) -> &[ManifoldBatch<1>] {
         self.singles.filled()
     }
 
     /// Where the step's batches lie, for the passes to ask for each next one while
     /// solving one, if the batches are too many to stay in the cache
     /// (`ASK_AHEAD_FROM_BYTES`).
-    pub fn batches_ahead(&self) -> BatchesAhead {
+    pub(crate) fn batches_ahead(&self) -> BatchesAhead {
         let bytes =
             std::mem::size_of_val(self.batches()) + std::mem::size_of_val(self.point_batches());
         BatchesAhead {
@@ -724,7 +724,7 @@ impl PassPlan {
     }
 
     /// The step's work and its batches, to solve them.
-    pub fn work(
+    pub(crate) fn work(
         &mut self,
     ) -> (
         &[PassItem],
@@ -1015,7 +1015,7 @@ impl<L: Lanes> LaneVelocity<L> {
     /// # Safety
     /// Every index must be below `bodies.len()` (`Lanes::gather`).
     #[inline(always)]
-    pub unsafe fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
+    pub(crate) unsafe fn load(bodies: &[SoftBody], index: &[u32; LANES]) -> Self {
         // SAFETY: the caller's precondition.
         let [x, y, w, inv_mass] = unsafe { L::gather(bodies, index, BodyRow::Velocity) };
         Self { x, y, w, inv_mass }
@@ -1024,7 +1024,7 @@ impl<L: Lanes> LaneVelocity<L> {
     /// # Safety
     /// As `load`.
     #[inline(always)]
-    pub unsafe fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
+    pub(crate) unsafe fn store(&self, bodies: &mut [SoftBody], index: &[u32; LANES]) {
         let columns = [self.x, self.y, self.w, self.inv_mass];
         // SAFETY: the caller's precondition.
         unsafe { L::scatter_velocities(columns, bodies, index) };
@@ -1081,14 +1081,14 @@ impl<L: Lanes> LanePair<L> {
 /// What one pass needs to find each point's target and softness (see `normal_target`).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct PassSettings {
-    pub inv_h: f64,
-    pub soft: Softness,
+    pub(super) inv_h: f64,
+    pub(super) soft: Softness,
     /// The softness of contacts with a fixed body.
-    pub static_soft: Softness,
-    pub max_push: f64,
+    pub(super) static_soft: Softness,
+    pub(super) max_push: f64,
     /// `SoftSettings::max_soft_depth`.
-    pub max_depth: f64,
-    pub use_bias: bool,
+    pub(super) max_depth: f64,
+    pub(super) use_bias: bool,
 }
 
 /// The lanes a batch is solved with: the widest this processor has.

@@ -85,7 +85,7 @@ pub(super) struct Mask8([u64; LANES]);
 
 impl F64x8 {
     #[inline(always)]
-    pub fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
+    pub(crate) fn from_fn(f: impl FnMut(usize) -> f64) -> Self {
         Self(std::array::from_fn(f))
     }
 

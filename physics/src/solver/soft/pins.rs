@@ -47,7 +47,7 @@ pub(super) struct PinPlan {
 impl PinPlan {
     /// Whether an island of `pins` pins is solved in batches (else as one block, or a lone
     /// pin in closed form).
-    pub fn batches_island(pins: usize) -> bool {
+    pub(crate) fn batches_island(pins: usize) -> bool {
         pins > DIRECT_JOINT_LIMIT
     }
 
@@ -56,7 +56,7 @@ impl PinPlan {
     /// null body, where unused lanes point. `unchanged`: the joints join the same bodies,
     /// each moving or not, as at the last call (`IslandGrouping::kept`), so the colours
     /// stand and only the batches' numbers are filled again.
-    pub fn plan(
+    pub(crate) fn plan(
         &mut self,
         joints: &[SoftJoint],
         islands: &[(usize, usize)],
@@ -132,12 +132,12 @@ impl PinPlan {
     }
 
     /// The pins of the batched islands that are solved alone, after the batches.
-    pub fn alone(&self) -> &[u32] {
+    pub(crate) fn alone(&self) -> &[u32] {
         &self.alone
     }
 
     /// Applies the batched pins' accumulated impulses at their anchors where they are now.
-    pub fn warm_start(&self, bodies: &mut [SoftBody]) {
+    pub(crate) fn warm_start(&self, bodies: &mut [SoftBody]) {
         let path = LanePath::best();
         for batch in &self.batches[..self.filled] {
             batch.warm_start_on(path, bodies);
@@ -145,7 +145,7 @@ impl PinPlan {
     }
 
     /// One pass over the batches, as `solve_joint` over their pins.
-    pub fn solve(&mut self, bodies: &mut [SoftBody], pass: &PinPass) {
+    pub(crate) fn solve(&mut self, bodies: &mut [SoftBody], pass: &PinPass) {
         let path = LanePath::best();
         for batch in &mut self.batches[..self.filled] {
             batch.solve_on(path, bodies, pass);
@@ -153,7 +153,7 @@ impl PinPlan {
     }
 
     /// The batched pins' accumulated impulses, into their joints.
-    pub fn scatter(&self, joints: &mut [SoftJoint]) {
+    pub(crate) fn scatter(&self, joints: &mut [SoftJoint]) {
         for batch in &self.batches[..self.filled] {
             let [x, y] = batch.impulse.map(|c| c.0);
             for (k, &pin) in batch.pin.iter().enumerate().filter(|&(_, &p)| p != PAD) {
@@ -167,9 +167,9 @@ impl PinPlan {
 /// together, and whether they do (the relax pass does not).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct PinPass {
-    pub soft: Softness,
-    pub max_push: f64,
-    pub use_bias: bool,
+    pub(super) soft: Softness,
+    pub(super) max_push: f64,
+    pub(super) use_bias: bool,
 }
 
 /// Eight pins with no moving body in common, lane by lane. Stored with `F64x8` lanes;

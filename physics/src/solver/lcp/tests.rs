@@ -1,8 +1,8 @@
 //! The boxed LCP solver against its definition (issue 3): random PSD problems, singular
 //! ones, tiny and huge diagonals, and a brute-force enumeration of active sets for n ≤ 8.
 
+use super::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use nalgebra::{DMatrix, DVector};
-use pe::solver::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
