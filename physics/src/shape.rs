@@ -16,6 +16,8 @@ pub enum ShapeError {
     TooManyVertices { count: usize, limit: usize },
     #[error("vertex {index} has a coordinate that is not a finite number")]
     NonFiniteCoordinate { index: usize },
+    #[error("the polygon spans {extent:e}: too large for its area to be computed")]
+    TooLarge { extent: f64 },
     #[error("vertices {first} and {second} are the same point")]
     RepeatedPoint { first: usize, second: usize },
     #[error("the polygon has (nearly) zero area")]
@@ -68,6 +70,10 @@ impl ConvexPolygon {
             return Err(ShapeError::NonFiniteCoordinate { index });
         }
         let size = extent(points);
+        // Area and moments are products of two (or four) coordinates: beyond this they overflow.
+        if !(size * size * size * size).is_finite() {
+            return Err(ShapeError::TooLarge { extent: size });
+        }
         let same_point = RELATIVE_TOLERANCE * size;
         for i in 0..points.len() {
             for j in i + 1..points.len() {
@@ -106,6 +112,10 @@ impl ConvexPolygon {
             if turn > RELATIVE_TOLERANCE * e0.norm() * e1.norm() {
                 vertices.push(here);
             }
+        }
+        // Only collinear vertices left: no area after all.
+        if vertices.len() < 3 {
+            return Err(ShapeError::ZeroArea);
         }
         Ok(Self { vertices })
     }
@@ -274,6 +284,39 @@ mod tests {
     /// Rounding in the polygon sums is a few ulps of the largest term.
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1.0)
+    }
+
+    #[test]
+    fn huge_coordinates_are_refused_not_overflowed() {
+        let huge = [v(-1e300, -1e300), v(1e300, -1e300), v(0.0, 1e300)];
+        assert!(matches!(
+            ConvexPolygon::new(&huge),
+            Err(ShapeError::TooLarge { .. })
+        ));
+    }
+
+    /// Every triangle with corners from extreme values is either refused or has finite,
+    /// positive mass properties (a fuzzed database once produced a polygon with no vertices).
+    #[test]
+    fn every_extreme_triangle_is_refused_or_sound() {
+        let values = [0.0, 1.0, -1.0, 1e-320, 1e16, 1e150, -1e150, 1e300, -1e300];
+        let n = values.len();
+        for code in 0..n.pow(6) {
+            let mut digits = (0..6).scan(code, |rest, _| {
+                let d = *rest % n;
+                *rest /= n;
+                Some(values[d])
+            });
+            let mut next = || digits.next().unwrap();
+            let points = [v(next(), next()), v(next(), next()), v(next(), next())];
+            if let Ok(polygon) = ConvexPolygon::new(&points) {
+                let mp = polygon.mass_properties();
+                assert!(polygon.vertices().len() >= 3, "{points:?}");
+                assert!(mp.area > 0.0 && mp.area.is_finite(), "{points:?}: {mp:?}");
+                assert!(mp.second_moment > 0.0 && mp.second_moment.is_finite());
+                assert!(mp.centroid.x.is_finite() && mp.centroid.y.is_finite());
+            }
+        }
     }
 
     #[test]
