@@ -199,6 +199,35 @@ fn a_save_writes_only_what_changed_and_unchanged_records_as_they_were() {
     assert_eq!(again.model, db.model);
 }
 
+/// What reading ignored with a warning (an unknown element, stray text, a CDATA section)
+/// is not kept by a save, as the warning says: its record is written afresh, and the saved
+/// file reads without a warning. Clean records beside it stay byte for byte.
+#[test]
+fn a_record_with_ignored_content_is_saved_without_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let clean = "<body name=\"clean\" density=\"1e+000\" cor=\"0\">\n    <vertex x=\"0\" y=\"0\"/><vertex x=\"1\" y=\"0\"/><vertex x=\"0\" y=\"1\"/>\n  </body>";
+    let bodies = format!(
+        "<bodies>\n  {clean}\n  <body name=\"odd\" density=\"1\" cor=\"0\">\n    <versex x=\"5\" y=\"5\"/>stray<![CDATA[x]]>\n    <vertex x=\"0\" y=\"0\"/><vertex x=\"2\" y=\"0\"/><vertex x=\"0\" y=\"2\"/>\n  </body>\n</bodies>\n"
+    );
+    std::fs::write(dir.path().join("bodies.xml"), &bodies).unwrap();
+    let (mut db, problems) = Database::load(dir.path());
+    let warnings: Vec<_> = problems.iter().filter(|p| !p.is_error()).collect();
+    assert_eq!(warnings.len(), 3, "{problems:#?}");
+    let copy = tempfile::tempdir().unwrap();
+    db.save_to(copy.path(), Overwrite::Never).unwrap();
+    let saved = std::fs::read_to_string(copy.path().join("bodies.xml")).unwrap();
+    assert!(
+        saved.contains(clean),
+        "the clean record as it was:\n{saved}"
+    );
+    for ignored in ["versex", "stray", "CDATA"] {
+        assert!(!saved.contains(ignored), "{ignored} was kept:\n{saved}");
+    }
+    let (again, problems) = Database::load(copy.path());
+    assert!(problems.is_empty(), "{problems:#?}");
+    assert_eq!(again.model, db.model);
+}
+
 /// A file that is there but cannot be read (here a folder named bodies.xml; also a file
 /// over the size limit, or one without permission) loads as an empty collection with an
 /// error, and a save never writes over it: an edit elsewhere saves the other files, and an

@@ -161,6 +161,7 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
             continue;
         }
         let what = named(el, "body");
+        let problems_before = problems.len();
         let mut f = Fields::new(el, file, what.clone(), &mut problems);
         let mut body = BodyDef {
             name: f.text("name"),
@@ -198,7 +199,12 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
             skipped = true;
         } else {
             records.push(body);
-            spans.push(el.span.clone());
+            // A record read with a problem is written afresh, not as it was.
+            spans.push(
+                el.span
+                    .clone()
+                    .filter(|_| problems.len() == problems_before),
+            );
         }
     }
     Read {
@@ -246,6 +252,7 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
             continue;
         }
         let what = named(el, "robot");
+        let problems_before = problems.len();
         let mut f = Fields::new(el, file, what.clone(), &mut problems);
         let mut robot = Robot {
             name: f.text("name"),
@@ -331,7 +338,12 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
             skipped = true;
         } else {
             records.push(robot);
-            spans.push(el.span.clone());
+            // A record read with a problem is written afresh, not as it was.
+            spans.push(
+                el.span
+                    .clone()
+                    .filter(|_| problems.len() == problems_before),
+            );
         }
     }
     Read {
@@ -353,6 +365,7 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
             continue;
         }
         let what = named(el, "scene");
+        let problems_before = problems.len();
         let mut f = Fields::new(el, file, what.clone(), &mut problems);
         let mut scene = Scene {
             name: f.text("name"),
@@ -392,7 +405,12 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
             skipped = true;
         } else {
             records.push(scene);
-            spans.push(el.span.clone());
+            // A record read with a problem is written afresh, not as it was.
+            spans.push(
+                el.span
+                    .clone()
+                    .filter(|_| problems.len() == problems_before),
+            );
         }
     }
     Read {

@@ -237,6 +237,9 @@ fn parse_once(
     let mut root: Option<Element> = None;
     // The record (a child of the root) being read: where its tag starts, and its name.
     let mut record: Option<(usize, String)> = None;
+    // Whether the open record holds something ignored: then it has no span, so that saving
+    // writes it afresh without what was ignored, as the warning says.
+    let mut record_has_ignored = false;
     let fail = |problem: Problem, record: &Option<(usize, String)>| SyntaxError {
         problem: Box::new(problem),
         record: record.clone(),
@@ -270,6 +273,7 @@ fn parse_once(
             Event::Start(start) => {
                 if starts_record(&stack) {
                     record = Some((tag_start, tag_name(&start)));
+                    record_has_ignored = false;
                 }
                 if stack.len() >= MAX_DEPTH {
                     let problem = Problem::error(
@@ -304,6 +308,7 @@ fn parse_once(
                 let mut done = stack.pop().expect("an end tag follows its start");
                 if stack.len() == 1
                     && let Some((start, _)) = &record
+                    && !record_has_ignored
                 {
                     done.span = Some(*start..reader.buffer_position() as usize);
                 }
@@ -318,6 +323,7 @@ fn parse_once(
             Event::Text(t) => {
                 let content = t.xml_content(XmlVersion::Implicit1_0);
                 if !content.trim().is_empty() {
+                    record_has_ignored |= stack.len() >= 2;
                     problems.push(ignored(
                         file,
                         &stack,
@@ -327,6 +333,7 @@ fn parse_once(
                 }
             }
             Event::CData(_) => {
+                record_has_ignored |= stack.len() >= 2;
                 problems.push(ignored(file, &stack, "CDATA section".into(), location));
             }
             Event::Eof => break,
