@@ -3,7 +3,7 @@
 
 use super::problem::Problem;
 use super::{FileKind, clip};
-use crate::model::{BodyDef, Model, Robot, Scene, SceneRobot, compose};
+use crate::model::{BodyDef, BodyMotorDef, Model, Placement, Robot, Scene, SceneRobot, compose};
 use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
 
@@ -176,29 +176,7 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                 .at(p.location),
             );
         }
-        for m in &b.motors {
-            let what = format!("<force> on {what}");
-            if m.time1 < m.time0 {
-                out.push(
-                    Problem::warning(file, &what, "time1 is before time0: the motor never runs")
-                        .at(m.location),
-                );
-            }
-            for message in beyond_all(&[
-                ("angular", m.angular, limits::ANGULAR),
-                ("startTorque", m.start_torque, limits::TORQUE),
-                ("maxTorque", m.max_torque, limits::TORQUE),
-                ("increase", m.increase, limits::INCREASE),
-            ]) {
-                out.push(Problem::error(file, &what, message).at(m.location));
-            }
-            if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
-                out.push(
-                    Problem::error(file, &what, "startTorque, maxTorque and increase must be ≥ 0 (the sign of angular gives the direction)")
-                        .at(m.location),
-                );
-            }
-        }
+        check_body_motors(&b.motors, &what, file, out);
     }
     // Connectivity by union-find over aliases (SPEC §4.1).
     let mut parent: Vec<usize> = (0..robot.bodies.len()).collect();
@@ -258,17 +236,9 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
         parent[ra] = rb;
         // The pin should lie in both bodies (SPEC §4.3.2: the centre of their overlap).
         let point = j.point(&robot.bodies[a].placement);
-        let inside = [a, b].iter().any(|&i| {
-            let p = &robot.bodies[i].placement;
-            model
-                .body(&p.source)
-                .and_then(|d| polygon(d).ok())
-                .is_some_and(|poly| {
-                    let (s, c) = p.orientation.sin_cos();
-                    let (dx, dy) = (point[0] - p.x, point[1] - p.y);
-                    poly.contains(Vec2::new(c * dx + s * dy, -s * dx + c * dy))
-                })
-        });
+        let inside = [a, b]
+            .iter()
+            .any(|&i| lies_in(model, &robot.bodies[i].placement, point));
         if !inside {
             out.push(
                 Problem::warning(
@@ -301,6 +271,46 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
             .at(robot.location),
         );
     }
+}
+
+/// A body's motors (`<force>`): their times, ranges and signs.
+fn check_body_motors(motors: &[BodyMotorDef], what: &str, file: &str, out: &mut Vec<Problem>) {
+    for m in motors {
+        let what = format!("<force> on {what}");
+        if m.time1 < m.time0 {
+            out.push(
+                Problem::warning(file, &what, "time1 is before time0: the motor never runs")
+                    .at(m.location),
+            );
+        }
+        for message in beyond_all(&[
+            ("angular", m.angular, limits::ANGULAR),
+            ("startTorque", m.start_torque, limits::TORQUE),
+            ("maxTorque", m.max_torque, limits::TORQUE),
+            ("increase", m.increase, limits::INCREASE),
+        ]) {
+            out.push(Problem::error(file, &what, message).at(m.location));
+        }
+        if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
+            out.push(
+                Problem::error(file, &what, "startTorque, maxTorque and increase must be ≥ 0 (the sign of angular gives the direction)")
+                    .at(m.location),
+            );
+        }
+    }
+}
+
+/// Whether `point` (robot coordinates) lies in the body placed by `placement`.
+fn lies_in(model: &Model, placement: &Placement, point: [f64; 2]) -> bool {
+    let p = placement;
+    model
+        .body(&p.source)
+        .and_then(|d| polygon(d).ok())
+        .is_some_and(|poly| {
+            let (s, c) = p.orientation.sin_cos();
+            let (dx, dy) = (point[0] - p.x, point[1] - p.y);
+            poly.contains(Vec2::new(c * dx + s * dy, -s * dx + c * dy))
+        })
 }
 
 fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>) {
