@@ -937,3 +937,7 @@ fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() 
     h.run_steps(2);
     h.get_by_label_contains("Back to step 0");
 }
+
+// More of the editor's tests, a file per feature.
+#[path = "editor/selection.rs"]
+mod selection;

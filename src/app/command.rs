@@ -72,16 +72,28 @@ pub enum Command {
     Undo,
     Redo,
     PlaceInScene(NewPlacement),
-    /// Move the placement behind simulated body `body` so that its origin goes to `to`.
+    /// Move the placement behind simulated body `body` so that its origin goes to `to`
+    /// (with the rest of the selection, if the body is selected).
     MovePlacement {
         body: usize,
         to: Vec2,
     },
-    /// Turn the placement behind simulated body `body` by `angle` (rad) about its origin.
+    /// Turn the placement behind simulated body `body` by `angle` (rad) about its origin
+    /// (or, when the body is selected with others, the selection about its middle).
     TurnPlacement {
         body: usize,
         angle: f64,
     },
+    /// Move the selected placements by this much (arrow keys at step 0).
+    Nudge(Vec2),
+    /// Select the placements behind these simulated bodies (a rubber band); with `add`,
+    /// besides those already selected.
+    Pick {
+        bodies: Vec<usize>,
+        add: bool,
+    },
+    /// Add the placement behind this simulated body to the selection, or take it out.
+    TogglePick(usize),
     /// The current tool was used at this world point.
     UseTool(Vec2),
     /// The body editor changed the selected body's outline.

@@ -15,6 +15,7 @@ mod edit_commands;
 mod file_commands;
 pub mod files;
 pub mod inspector;
+mod placements;
 pub mod placing;
 pub mod plot_data;
 pub mod plots;
@@ -90,9 +91,12 @@ pub struct RoboSimApp {
     runner: Runner,
     view: canvas::CanvasView,
     selection: Option<Selection>,
-    /// The body the inspector and the plots follow and Copy takes (index into the
-    /// simulation's bodies).
+    /// The body the inspector and the plots follow (index into the simulation's bodies).
     followed: Option<usize>,
+    /// The bodies selected on the canvas (indices into the simulation's bodies): every
+    /// body of each selected placement, the followed one among them. Edits at step 0
+    /// (move, nudge, turn, delete, copy, duplicate) apply to the placements behind them.
+    picked: Vec<usize>,
     toolbar: toolbar::Toolbar,
     inspector: inspector::Inspector,
     plots: plots::PlotsPanel,
@@ -103,7 +107,7 @@ pub struct RoboSimApp {
     show_about: bool,
     /// How the app asks for folders and file names.
     files: Box<dyn files::FileChooser>,
-    copied: Option<Copied>,
+    copied: Option<placements::Clipboard>,
     /// The window may close: the user answered the unsaved-changes question.
     close_confirmed: bool,
     /// A PNG export of the view the integration finished (on its own thread): where, or
@@ -121,6 +125,7 @@ impl RoboSimApp {
             view: canvas::CanvasView::default(),
             selection: None,
             followed: None,
+            picked: Vec::new(),
             toolbar: toolbar::Toolbar::default(),
             inspector: inspector::Inspector::default(),
             plots: plots::PlotsPanel::default(),
@@ -224,6 +229,11 @@ impl RoboSimApp {
         self.followed
     }
 
+    /// The bodies selected on the canvas (indices into the simulation's bodies).
+    pub fn picked(&self) -> &[usize] {
+        &self.picked
+    }
+
     // Applying commands.
 
     fn inform(&mut self, news: String) {
@@ -253,6 +263,7 @@ impl RoboSimApp {
     /// Shows `selection`: a scene is built and runs; a robot or a body is previewed still.
     pub fn select(&mut self, selection: Selection) {
         self.followed = None;
+        self.picked.clear();
         match self.runner.show(self.doc.model(), &selection, None) {
             Ok(()) => self.inform(String::new()),
             Err(e) => self.complain(e),
@@ -269,6 +280,7 @@ impl RoboSimApp {
     fn model_changed(&mut self) {
         let had_bodies = self.sim().is_some_and(|s| !s.bodies.is_empty());
         let (camera, fitted, followed) = (self.view.camera, self.view.fitted, self.followed);
+        let picked = std::mem::take(&mut self.picked);
         let message = self.message.clone();
         match self.selection.clone() {
             Some(sel) if self.doc.has(&sel) => {
@@ -280,7 +292,9 @@ impl RoboSimApp {
                 self.runner.running = false;
                 self.view.camera = camera;
                 self.view.fitted = fitted && had_bodies;
-                self.followed = followed.filter(|&i| i < self.sim().map_or(0, |s| s.bodies.len()));
+                let count = self.sim().map_or(0, |s| s.bodies.len());
+                self.followed = followed.filter(|&i| i < count);
+                self.picked = picked.into_iter().filter(|&i| i < count).collect();
             }
             _ => {
                 self.selection = None;
@@ -339,10 +353,7 @@ impl RoboSimApp {
             }
             C::SetSnap(step) => self.view.snap_step = step,
             C::SetDebug(debug) => self.view.debug = debug,
-            C::Follow(body) => {
-                self.followed = body;
-                self.runner.restart_plots(body);
-            }
+            C::Follow(body) => self.follow(body),
             C::ToggleProblems => self.show_problems = !self.show_problems,
             C::ShowShortcuts => self.show_shortcuts = true,
             C::ShowAbout => self.show_about = true,
@@ -398,18 +409,33 @@ impl RoboSimApp {
                     angle: turn * 15f64.to_radians(),
                 }
             }
-            A::MotorsFaster | A::MotorsSlower => {
+            A::Left | A::Right if self.runner.editing() => {
+                let step = if action == A::Right { 1.0 } else { -1.0 };
+                Command::Nudge(pe::Vec2::new(step * self.nudge_step(), 0.0))
+            }
+            A::Up | A::Down if self.runner.editing() => {
+                // y points down, as on screen: Up moves to smaller y.
+                let step = if action == A::Down { 1.0 } else { -1.0 };
+                Command::Nudge(pe::Vec2::new(0.0, step * self.nudge_step()))
+            }
+            A::Left | A::Right => return None,
+            A::Up | A::Down => {
                 if !self.runner.running {
                     return None;
                 }
                 self.runner
-                    .change_throttle(if action == A::MotorsFaster { 1 } else { -1 });
+                    .change_throttle(if action == A::Up { 1 } else { -1 });
                 Command::Inform(format!(
                     "joint motors at {}× their speed (↑ / ↓ change it, R resets)",
                     self.runner.throttle()
                 ))
             }
         })
+    }
+
+    /// How far an arrow key moves the selection: one grid step, or one unit unsnapped.
+    fn nudge_step(&self) -> f64 {
+        self.view.snap_step.unwrap_or(1.0)
     }
 
     fn bar_state(&self) -> toolbar::State<'_> {
@@ -481,6 +507,7 @@ impl RoboSimApp {
                 let running = inspector::Running {
                     sim: self.runner.sim(),
                     followed: self.followed,
+                    items_picked: self.picked_owners().len(),
                 };
                 let model = self.doc.model();
                 commands.extend(
@@ -512,6 +539,7 @@ impl RoboSimApp {
             sim,
             editing,
             followed: self.followed,
+            picked: &self.picked,
             overlaps: parts.overlaps,
             bound: parts.bound,
         };

@@ -22,8 +22,14 @@ pub enum Action {
     Fit,
     RotateLeft,
     RotateRight,
-    MotorsFaster,
-    MotorsSlower,
+    /// While running, joint motors faster; at step 0, the selection up a grid step.
+    Up,
+    /// While running, joint motors slower; at step 0, the selection down a grid step.
+    Down,
+    /// At step 0, the selection a grid step left.
+    Left,
+    /// At step 0, the selection a grid step right.
+    Right,
     ShowShortcuts,
 }
 
@@ -52,22 +58,26 @@ pub const SHORTCUTS: &[(Action, KeyboardShortcut, &str)] = &[
     ),
     (Action::Undo, command(Key::Z), "Undo the last edit"),
     (Action::Redo, command(Key::Y), "Redo"),
-    (Action::Cut, command(Key::X), "Cut the selected placement"),
-    (Action::Copy, command(Key::C), "Copy the selected placement"),
+    (Action::Cut, command(Key::X), "Cut the selected placements"),
+    (
+        Action::Copy,
+        command(Key::C),
+        "Copy the selected placements",
+    ),
     (
         Action::Paste,
         command(Key::V),
-        "Paste the copied placement in free space at the view's centre",
+        "Paste the copied placements in free space at the view's centre",
     ),
     (
         Action::Duplicate,
         command(Key::D),
-        "Duplicate the selected item",
+        "Duplicate the selected placements (at step 0), or else the selected item",
     ),
     (
         Action::Delete,
         plain(Key::Delete),
-        "Delete the selected placement, or the selected item",
+        "Delete the selected placements, or else the selected item",
     ),
     (Action::PlayPause, plain(Key::Space), "Run or pause"),
     (Action::Step, plain(Key::S), "One physics step"),
@@ -80,22 +90,32 @@ pub const SHORTCUTS: &[(Action, KeyboardShortcut, &str)] = &[
     (
         Action::RotateLeft,
         plain(Key::Q),
-        "Turn the selected placement 15° anticlockwise (step 0)",
+        "Turn the selected placements 15° anticlockwise (step 0)",
     ),
     (
         Action::RotateRight,
         plain(Key::E),
-        "Turn the selected placement 15° clockwise (step 0)",
+        "Turn the selected placements 15° clockwise (step 0)",
     ),
     (
-        Action::MotorsFaster,
+        Action::Up,
         plain(Key::ArrowUp),
-        "While running: joint motors faster (steps of ½ their speed, up to 2×)",
+        "At step 0: move the selection up one grid step. While running: joint motors faster (steps of ½ their speed, up to 2×)",
     ),
     (
-        Action::MotorsSlower,
+        Action::Down,
         plain(Key::ArrowDown),
-        "While running: joint motors slower, then backwards (down to −2×)",
+        "At step 0: move the selection down one grid step. While running: joint motors slower, then backwards (down to −2×)",
+    ),
+    (
+        Action::Left,
+        plain(Key::ArrowLeft),
+        "At step 0: move the selection left one grid step",
+    ),
+    (
+        Action::Right,
+        plain(Key::ArrowRight),
+        "At step 0: move the selection right one grid step",
     ),
     (Action::ShowShortcuts, plain(Key::F1), "This list"),
 ];

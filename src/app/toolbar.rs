@@ -291,28 +291,28 @@ fn edit_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
             s.placement_selected,
             "Cut",
             Action::Cut,
-            "Remove the selected placement, keeping a copy",
+            "Remove the selected placements, keeping a copy",
             Command::CutPlacement,
         ),
         (
             s.placement_selected,
             "Copy",
             Action::Copy,
-            "Copy the selected placement",
+            "Copy the selected placements",
             Command::CopyPlacement,
         ),
         (
             s.can_paste,
             "Paste",
             Action::Paste,
-            "Paste the copied placement in free space at the view's centre",
+            "Paste the copied placements in free space at the view's centre",
             Command::PastePlacement,
         ),
         (
             s.selection.is_some(),
             "Duplicate",
             Action::Duplicate,
-            "Copy the selected item under a new name",
+            "Copy the selected placements beside them (at step 0), or else the selected item under a new name",
             Command::Duplicate,
         ),
     ];
@@ -326,7 +326,7 @@ fn edit_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
         s.selection.is_some(),
         "Delete",
         Some(Action::Delete),
-        "Delete the selected placement, or the selected item (refused while it is used)",
+        "Delete the selected placements, or else the selected item (refused while it is used)",
     ) {
         out.push(Command::DeleteSelected);
     }

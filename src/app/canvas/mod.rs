@@ -93,6 +93,9 @@ pub struct CanvasView {
     pub snap_step: Option<f64>,
     /// The vertex being dragged in the body editor.
     pub vertex_drag: Option<usize>,
+    /// The rubber band being dragged out on empty canvas: where the drag started and
+    /// where the pointer is (screen points).
+    pub band: Option<(egui::Pos2, egui::Pos2)>,
 }
 
 impl Default for CanvasView {
@@ -106,6 +109,7 @@ impl Default for CanvasView {
             tool: Tool::Select,
             snap_step: Some(0.5),
             vertex_drag: None,
+            band: None,
         }
     }
 }
@@ -118,9 +122,14 @@ pub struct Scene<'a> {
     pub editing: bool,
     /// The body the inspector and plots follow (index into `sim.bodies`).
     pub followed: Option<usize>,
+    /// The bodies selected (indices into `sim.bodies`), the followed one among them.
+    pub picked: &'a [usize],
     pub overlaps: &'a [(usize, usize)],
     pub bound: Option<&'a WorldBound>,
 }
+
+/// The rubber band's colour.
+const BAND: Color32 = Color32::from_rgb(120, 180, 255);
 
 /// Points between a selected body's outline and its rotate handle.
 const HANDLE_OFFSET: f32 = 24.0;
@@ -163,7 +172,13 @@ impl CanvasView {
         }
         let mut commands = Vec::new();
         let followed = self.pointer(ui, &response, scene, grab, &mut commands);
-        let selected: Vec<usize> = followed.into_iter().collect();
+        self.rubber_band(ui, &response, scene, &mut commands);
+        // A click this frame shows at once what it selected; the app's selection next frame.
+        let selected: Vec<usize> = if followed == scene.followed {
+            scene.picked.to_vec()
+        } else {
+            followed.into_iter().collect()
+        };
         let marks = draw::Highlights {
             selected: &selected,
             overlaps: if scene.editing { scene.overlaps } else { &[] },
@@ -176,6 +191,15 @@ impl CanvasView {
             marks,
         ));
         self.handle_and_grab(&painter, scene, followed, grab.as_ref());
+        if let Some((from, to)) = self.band {
+            painter.rect(
+                Rect::from_two_pos(from, to),
+                0.0,
+                BAND.gamma_multiply(0.15),
+                Stroke::new(1.0, BAND),
+                egui::StrokeKind::Inside,
+            );
+        }
         self.hints(ui, &painter, scene);
         commands
     }
@@ -243,12 +267,24 @@ impl CanvasView {
         }
         let turning = scene.editing && ui.ctx().data(|d| d.get_temp(turning_id).unwrap_or(false));
         let mut followed = scene.followed;
+        // The body a drag at step 0 moves (with the selection, if it is in it).
+        let dragged_id = response.id.with("dragged body");
         if selecting && !turning && (drag_started || response.clicked()) {
             let at = if drag_started { pressed } else { pointer };
             let hit = at.and_then(|p| body_at(sim, p, scene.followed));
-            if hit != followed {
+            let shift = ui.input(|i| i.modifiers.shift);
+            let in_selection = hit.is_some_and(|i| scene.picked.contains(&i));
+            if scene.editing && shift && response.clicked() {
+                commands.extend(hit.map(Command::TogglePick));
+            } else if scene.editing && drag_started && (hit.is_none() || in_selection) {
+                // On empty canvas a drag draws a rubber band; on a selected body it moves
+                // the whole selection: neither changes what is selected yet.
+            } else if hit != followed || (response.clicked() && scene.picked.len() > 1) {
                 followed = hit;
                 commands.push(Command::Follow(hit));
+            }
+            if drag_started {
+                ui.ctx().data_mut(|d| d.insert_temp(dragged_id, hit));
             }
             if drag_started && !scene.editing {
                 *grab = hit.zip(at).and_then(|(i, p)| grab_at(sim, i, p));
@@ -257,23 +293,62 @@ impl CanvasView {
         if let (Some(g), Some(p)) = (grab.as_mut(), pointer) {
             g.target = p;
         }
+        let dragged = ui.ctx().data(|d| d.get_temp::<Option<usize>>(dragged_id));
         if scene.editing
             && selecting
-            && let (Some(i), Some(p)) = (followed, pointer)
+            && let Some(p) = pointer
         {
             let dragging = response.dragged_by(PointerButton::Primary)
                 && response.drag_delta() != egui::Vec2::ZERO;
             if turning {
-                commands.extend(turn(ui, sim, i, pressed, p, dragging));
-            } else {
+                commands.extend(followed.and_then(|i| turn(ui, sim, i, pressed, p, dragging)));
+            } else if let Some(i) = dragged.flatten() {
                 commands.extend(move_by_drag(ui, response, sim, i, pressed, p, dragging));
             }
         }
         if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
             *grab = None;
-            ui.ctx().data_mut(|d| d.insert_temp(turning_id, false));
+            ui.ctx().data_mut(|d| {
+                d.insert_temp(turning_id, false);
+                d.remove::<Option<usize>>(dragged_id);
+            });
         }
         followed
+    }
+
+    /// At step 0 with the select tool, a drag that starts on empty canvas draws a rubber
+    /// band; on release the placements whose bodies it touches are selected (Shift: added).
+    fn rubber_band(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        scene: Scene<'_>,
+        commands: &mut Vec<Command>,
+    ) {
+        if !scene.editing || self.tool != Tool::Select {
+            self.band = None;
+            return;
+        }
+        let (camera, rect) = (self.camera, self.rect);
+        if response.drag_started_by(PointerButton::Primary) {
+            let empty = ui
+                .input(|i| i.pointer.press_origin())
+                .filter(|&p| body_at(scene.sim, camera.to_world(rect, p), None).is_none());
+            self.band = empty.map(|p| (p, p));
+        }
+        let Some((from, to)) = self.band.as_mut() else {
+            return;
+        };
+        if let Some(p) = response.interact_pointer_pos() {
+            *to = p;
+        }
+        if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
+            let (a, b) = (camera.to_world(rect, *from), camera.to_world(rect, *to));
+            let bodies = bodies_touching(scene.sim, a.inf(&b), a.sup(&b));
+            let add = ui.input(|i| i.modifiers.shift);
+            commands.push(Command::Pick { bodies, add });
+            self.band = None;
+        }
     }
 
     /// Where the rotate handle of body `i` is on screen: above its outline.
@@ -324,7 +399,7 @@ impl CanvasView {
         }
         let hint = match self.tool {
             Tool::Select => {
-                "editing at step 0: drag a body to move it · drag its handle or Q / E to turn it · Play runs"
+                "editing at step 0: drag a body to move it · drag on empty space to select several (Shift adds) · drag the handle or Q / E to turn · Play runs"
             }
             Tool::Joint => "joint tool: click a point where two bodies overlap to pin them there",
         };
@@ -499,6 +574,20 @@ pub fn body_at(sim: &Simulation, p: Vec2, selected: Option<usize>) -> Option<usi
         .into_iter()
         .rev()
         .find(|&i| covers(sim, i, p))
+}
+
+/// The bodies (indices into `sim.bodies`) whose outlines touch or lie inside the world
+/// rectangle from `min` to `max`.
+pub fn bodies_touching(sim: &Simulation, min: Vec2, max: Vec2) -> Vec<usize> {
+    let band = [min, Vec2::new(max.x, min.y), max, Vec2::new(min.x, max.y)];
+    (0..sim.bodies.len())
+        .filter(|&i| {
+            sim.world.body(sim.bodies[i].handle).is_some_and(|b| {
+                let outline: Vec<Vec2> = b.world_vertices().collect();
+                super::placing::overlap_depth(&band, &outline) >= 0.0
+            })
+        })
+        .collect()
 }
 
 /// The world rectangle around every body, the static ones clipped to the dynamic ones'

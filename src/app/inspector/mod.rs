@@ -32,6 +32,8 @@ pub struct Running<'a> {
     pub sim: Option<&'a Simulation>,
     /// The body followed (index into `sim.bodies`).
     pub followed: Option<usize>,
+    /// How many placements are selected on the canvas.
+    pub items_picked: usize,
 }
 
 impl Inspector {
@@ -69,6 +71,13 @@ impl Inspector {
             }
             if !matches!(selection, Selection::Body(_)) {
                 ui.separator();
+                if running.items_picked > 1 {
+                    ui.strong(format!("{} items selected", running.items_picked))
+                        .on_hover_text(
+                            "Delete, Cut, Copy, Paste, Duplicate, the arrow keys, Q / E and a \
+                             drag apply to all of them; the body below is the one followed",
+                        );
+                }
                 followed_body(ui, running.sim, running.followed);
             }
         });

@@ -1,0 +1,215 @@
+//! Rubber-band selection at step 0 and the edits that apply to every selected placement
+//! at once, each one undo step.
+
+use super::{click_world, drag_world, harness, scratch_db, stop_at_step_0};
+use egui::{Event, Key, Modifiers, PointerButton};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use robosim::app::RoboSimApp;
+use robosim::model::{Placement, Scene};
+
+const STACK: &str = "stack of boxes";
+
+fn stack(h: &Harness<'_, RoboSimApp>) -> Scene {
+    h.state().model().scene(STACK).unwrap().clone()
+}
+
+fn body<'s>(scene: &'s Scene, alias: &str) -> &'s Placement {
+    scene.bodies.iter().find(|b| b.alias == alias).unwrap()
+}
+
+/// The trace ids of the selected bodies, sorted.
+fn picked_ids(h: &Harness<'_, RoboSimApp>) -> Vec<String> {
+    let sim = h.state().sim().unwrap();
+    let mut ids: Vec<String> = h
+        .state()
+        .picked()
+        .iter()
+        .map(|&i| sim.bodies[i].id.clone())
+        .collect();
+    ids.sort();
+    ids
+}
+
+/// Drags a rubber band from world point `from` to `to`, with `modifiers` held.
+fn band(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64), modifiers: Modifiers) {
+    let app = h.state();
+    let screen = |(x, y): (f64, f64)| {
+        app.camera()
+            .to_screen(app.canvas_rect(), pe::Vec2::new(x, y))
+    };
+    let (start, end) = (screen(from), screen(to));
+    h.event(Event::ModifiersChanged(modifiers));
+    h.event(Event::PointerMoved(start));
+    h.run_steps(1);
+    let button = |pos, pressed| Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers,
+    };
+    h.event(button(start, true));
+    h.run_steps(1);
+    for k in 1..=4 {
+        h.event(Event::PointerMoved(
+            start + (end - start) * (k as f32 / 4.0),
+        ));
+        h.run_steps(1);
+    }
+    h.event(button(end, false));
+    h.run_steps(2);
+    h.event(Event::ModifiersChanged(Modifiers::NONE));
+    h.run_steps(1);
+}
+
+/// Boxes 2, 3 and 4 of the stack (30 × 30 at x = 400, y = 335, 305, 275): a band from
+/// y = 262 to 340 touches them and not box 1 (from y = 350) or box 5 (to y = 260).
+fn pick_three(h: &mut Harness<'_, RoboSimApp>) {
+    band(h, (360.0, 262.0), (440.0, 340.0), Modifiers::NONE);
+    assert_eq!(picked_ids(h), ["box 2", "box 3", "box 4"]);
+}
+
+fn undo(h: &mut Harness<'_, RoboSimApp>) {
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run_steps(2);
+}
+
+#[test]
+fn a_rubber_band_selects_what_it_touches_and_shift_adds() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label(STACK).click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    pick_three(&mut h);
+    h.get_by_label("3 items selected");
+    // Shift adds the ball (a circle-like polygon about (250, 100)).
+    band(&mut h, (230.0, 80.0), (270.0, 120.0), Modifiers::SHIFT);
+    assert_eq!(picked_ids(&h), ["ball", "box 2", "box 3", "box 4"]);
+    // A plain band replaces the selection; a click on empty canvas clears it.
+    band(&mut h, (360.0, 140.0), (440.0, 170.0), Modifiers::NONE);
+    assert_eq!(picked_ids(&h), ["box 8"]);
+    click_world(&mut h, 600.0, 200.0, Modifiers::NONE);
+    assert!(h.state().picked().is_empty());
+    assert_eq!(h.state().followed(), None);
+}
+
+#[test]
+fn delete_nudge_drag_and_turn_apply_to_the_whole_selection_as_one_undo_step() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label(STACK).click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    let before = h.state().model().clone();
+    let count = stack(&h).bodies.len();
+
+    pick_three(&mut h);
+    h.key_press(Key::Delete);
+    h.run_steps(2);
+    let after = stack(&h);
+    assert_eq!(after.bodies.len(), count - 3);
+    let aliases: Vec<&str> = after.bodies.iter().map(|b| b.alias.as_str()).collect();
+    assert!(
+        !aliases
+            .iter()
+            .any(|a| ["box 2", "box 3", "box 4"].contains(a))
+    );
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before, "one undo brings all three back");
+
+    // Arrow keys move all three one grid step (0.5); one undo puts them back.
+    pick_three(&mut h);
+    h.key_press(Key::ArrowRight);
+    h.run_steps(2);
+    h.key_press(Key::ArrowUp);
+    h.run_steps(2);
+    let nudged = stack(&h);
+    for (alias, y) in [("box 2", 335.0), ("box 3", 305.0), ("box 4", 275.0)] {
+        let b = body(&nudged, alias);
+        assert_eq!((b.x, b.y), (400.5, y - 0.5), "{alias}");
+    }
+    assert_eq!(body(&nudged, "box 1").x, 400.0, "box 1 is not selected");
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+
+    // Dragging one selected box moves the other two with it.
+    pick_three(&mut h);
+    drag_world(&mut h, (400.0, 305.0), (460.0, 305.0));
+    let dragged = stack(&h);
+    for (alias, y) in [("box 2", 335.0), ("box 3", 305.0), ("box 4", 275.0)] {
+        let b = body(&dragged, alias);
+        assert_eq!((b.x, b.y), (460.0, y), "{alias}: {}", h.state().status());
+    }
+    assert_eq!(body(&dragged, "box 1").x, 400.0);
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+
+    // E turns the three 15° about their middle, box 3's origin (400, 305).
+    pick_three(&mut h);
+    h.key_press(Key::E);
+    h.run_steps(2);
+    let turned = stack(&h);
+    let a = 15f64.to_radians();
+    let b2 = body(&turned, "box 2");
+    assert!((b2.x - (400.0 - 30.0 * a.sin())).abs() < 1e-9, "{}", b2.x);
+    assert!((b2.y - (305.0 + 30.0 * a.cos())).abs() < 1e-9, "{}", b2.y);
+    let b3 = body(&turned, "box 3");
+    assert_eq!((b3.x, b3.y), (400.0, 305.0));
+    for alias in ["box 2", "box 3", "box 4"] {
+        assert!((body(&turned, alias).orientation - a).abs() < 1e-12);
+    }
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+}
+
+#[test]
+fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label(STACK).click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    let before = h.state().model().clone();
+    let count = stack(&h).bodies.len();
+
+    pick_three(&mut h);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::C);
+    h.run_steps(1);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run_steps(2);
+    let pasted = stack(&h);
+    assert_eq!(pasted.bodies.len(), count + 3, "{}", h.state().status());
+    let new: Vec<&Placement> = pasted.bodies[count..].iter().collect();
+    let aliases: Vec<&str> = new.iter().map(|b| b.alias.as_str()).collect();
+    assert_eq!(aliases, ["box 2 2", "box 3 2", "box 4 2"]);
+    // One offset for the group: the boxes stay stacked 30 apart.
+    assert_eq!(new[0].x, new[1].x);
+    assert_eq!(new[0].y - new[1].y, 30.0);
+    assert_eq!(new[1].y - new[2].y, 30.0);
+    assert!(h.state().overlaps().is_empty(), "pasted in free space");
+    assert_eq!(
+        picked_ids(&h),
+        ["box 2 2", "box 3 2", "box 4 2"],
+        "the pasted boxes are selected"
+    );
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before, "one undo removes all three");
+
+    pick_three(&mut h);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::D);
+    h.run_steps(2);
+    assert_eq!(stack(&h).bodies.len(), count + 3);
+    assert_eq!(h.state().model().scenes.len(), before.scenes.len());
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+
+    // Cut takes the three out; paste puts them back in one step.
+    pick_three(&mut h);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::X);
+    h.run_steps(2);
+    assert_eq!(stack(&h).bodies.len(), count - 3);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::V);
+    h.run_steps(2);
+    assert_eq!(stack(&h).bodies.len(), count);
+}
