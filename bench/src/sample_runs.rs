@@ -324,7 +324,11 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
     let mut columns: Vec<String> = vec!["moving bodies".into(), "steps (timed)".into()];
     columns.extend(engines.iter().cloned());
     columns.extend(["pe auto ÷ rapier2d".into(), "pe auto ÷ Box2D v3".into()]);
-    let _ = writeln!(w, "{}", crate::table_head(&["sample"], &columns, "---:"));
+    let _ = writeln!(
+        w,
+        "{}",
+        crate::report::table_head(&["sample"], &columns, "---:")
+    );
     for r in rows {
         let t = &r.pe[0].timing;
         let _ = write!(
@@ -333,13 +337,13 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
             r.name, r.moving, t.planned, t.timed_steps
         );
         for run in r.pe.iter().chain(&r.peers) {
-            let _ = write!(w, " {} |", crate::time_cell(&run.timing));
+            let _ = write!(w, " {} |", crate::report::time_cell(&run.timing));
         }
         for peer in &r.peers {
             let _ = write!(
                 w,
                 " {} |",
-                crate::ratio(r.pe[0].timing.median, peer.timing.median)
+                crate::report::ratio(r.pe[0].timing.median, peer.timing.median)
             );
         }
         let _ = writeln!(w);
@@ -351,7 +355,11 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
     );
     let mut columns = vec!["criterion".to_string()];
     columns.extend(engines.iter().cloned());
-    let _ = writeln!(w, "{}", crate::table_head(&["sample"], &columns, "---"));
+    let _ = writeln!(
+        w,
+        "{}",
+        crate::report::table_head(&["sample"], &columns, "---")
+    );
     for r in rows {
         let _ = write!(w, "| {} | {} |", r.name, criterion_text(&r.criterion));
         for run in r.pe.iter().chain(&r.peers) {
@@ -377,18 +385,22 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
             "within the target",
         ]
         .map(String::from);
-        let _ = writeln!(w, "{}", crate::table_head(&["sample"], &columns, "---:"));
+        let _ = writeln!(
+            w,
+            "{}",
+            crate::report::table_head(&["sample"], &columns, "---:")
+        );
         for r in pivoting {
             let (e, s) = (&r.pe[exact].timing, &r.pe[soft].timing);
-            let over = crate::time_ratio(e.median, s.median);
+            let over = crate::report::time_ratio(e.median, s.median);
             let _ = writeln!(
                 w,
                 "| {} | {} of {} | {} | {} | {over:.2} | {} |",
                 r.name,
                 r.pe[0].pivoted_steps,
                 r.pe[0].timing.steps_run,
-                crate::time_cell(e),
-                crate::time_cell(s),
+                crate::report::time_cell(e),
+                crate::report::time_cell(s),
                 if over <= EXACT_OVER_SOFT { "yes" } else { "no" }
             );
         }
@@ -413,7 +425,7 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
             SMALL_BUDGET.as_secs_f64() * 1e3,
             PE_SOLVERS[0].name(),
             slowest.name,
-            crate::pretty(slowest.pe[0].timing.median)
+            crate::report::pretty(slowest.pe[0].timing.median)
         );
     }
 }
