@@ -301,10 +301,10 @@ struct Broken {
 }
 
 #[test]
-fn each_broken_file_gives_its_specific_problem() {
+fn each_broken_bodies_file_gives_its_specific_problem() {
     use FileKind::*;
     use Severity::*;
-    let cases = [
+    each_gives_its_problem(&[
         Broken {
             file: "truncated_bodies.xml",
             kind: Bodies,
@@ -375,6 +375,14 @@ fn each_broken_file_gives_its_specific_problem() {
             says: "cor 1.5 is outside [0, 1]",
             line: Some(2),
         },
+    ]);
+}
+
+#[test]
+fn each_broken_robots_file_gives_its_specific_problem() {
+    use FileKind::*;
+    use Severity::*;
+    each_gives_its_problem(&[
         Broken {
             file: "dangling_robots.xml",
             kind: Robots,
@@ -403,6 +411,14 @@ fn each_broken_file_gives_its_specific_problem() {
             says: "lies in neither body",
             line: Some(5),
         },
+    ]);
+}
+
+#[test]
+fn each_broken_scenes_file_gives_its_specific_problem() {
+    use FileKind::*;
+    use Severity::*;
+    each_gives_its_problem(&[
         Broken {
             file: "dangling_scenes.xml",
             kind: Scenes,
@@ -431,7 +447,12 @@ fn each_broken_file_gives_its_specific_problem() {
             says: "no root element",
             line: None,
         },
-    ];
+    ]);
+}
+
+/// Loads each case's file (beside a valid bodies.xml) and finds its problem, with its
+/// severity and line, in a message that names the file.
+fn each_gives_its_problem(cases: &[Broken]) {
     for case in cases {
         let text = std::fs::read(Path::new("tests/corpus").join(case.file)).unwrap();
         let mut files: Vec<(FileKind, &[u8])> = vec![(case.kind, &text)];
