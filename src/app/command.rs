@@ -6,7 +6,7 @@ use super::Selection;
 use super::canvas::DebugDraw;
 use super::document::ItemKind;
 use super::inspector::NewPlacement;
-use super::tools::Tool;
+use super::tools::{ShapeOptions, Tool};
 use crate::db::Delete;
 use crate::model::Model;
 use pe::{ContactSolver, Vec2};
@@ -96,6 +96,11 @@ pub enum Command {
     TogglePick(usize),
     /// The current tool was used at this world point.
     UseTool(Vec2),
+    /// A drawing tool was dragged from `from` to `to` (world, snapped): make the body.
+    DrawShape {
+        from: Vec2,
+        to: Vec2,
+    },
     /// The body editor changed the selected body's outline.
     SetVertices {
         vertices: Vec<[f64; 2]>,
@@ -120,6 +125,7 @@ pub enum Command {
     Fit,
     SetTool(Tool),
     SetSnap(Option<f64>),
+    SetShapeOptions(ShapeOptions),
     SetDebug(DebugDraw),
     /// The body the inspector and the plots follow (index into the simulation's bodies).
     Follow(Option<usize>),

@@ -34,6 +34,7 @@ impl RoboSimApp {
             Command::Pick { bodies, add } => self.pick(&bodies, add),
             Command::TogglePick(body) => self.toggle_pick(body),
             Command::UseTool(p) => self.use_tool(p, now),
+            Command::DrawShape { from, to } => self.draw_shape(from, to, now),
             Command::SetVertices { vertices, key } => self.set_vertices(vertices, &key, now),
             Command::CopyPlacement => {
                 if let Some(clip) = self.copy_picked() {
@@ -154,6 +155,44 @@ impl RoboSimApp {
                 self.commit(draft, "add joint", now);
             }
             Err(why) => self.complain(why),
+        }
+    }
+
+    /// Makes the body a drawing tool's drag from `from` to `to` sizes: a new body
+    /// definition placed where it was drawn in the scene or robot shown, one undo step
+    /// for both, and selected.
+    fn draw_shape(&mut self, from: Vec2, to: Vec2, now: f64) {
+        let Some(into) = self.selection.clone() else {
+            return;
+        };
+        let shape = match tools::drawn_shape(self.view.tool, self.view.shape, from, to) {
+            Ok(shape) => shape,
+            Err(why) => return self.complain(why),
+        };
+        let at = shape.at;
+        // Terrain only in scenes: a robot's static body would pin it in place.
+        let terrain = self.view.shape.terrain && matches!(into, Selection::Scene(_));
+        let mut draft = self.doc.model().clone();
+        let name = match tools::add_drawn_body(&mut draft, &into, shape, terrain) {
+            Ok(name) => name,
+            Err(why) => return self.complain(why),
+        };
+        let owner = match &into {
+            Selection::Scene(n) => draft
+                .scene(n)
+                .map(|s| placements::Owner::SceneBody(s.bodies.len() - 1)),
+            Selection::Robot(n) => draft
+                .robot(n)
+                .map(|r| placements::Owner::RobotBody(r.bodies.len() - 1)),
+            Selection::Body(_) => None,
+        };
+        self.inform(format!(
+            "drew {name} at ({}, {}): a new body, also in the library",
+            at.x, at.y
+        ));
+        self.commit(draft, &format!("draw {name}"), now);
+        if let Some(owner) = owner {
+            self.pick_owners(&[owner]);
         }
     }
 

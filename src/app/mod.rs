@@ -268,7 +268,7 @@ impl RoboSimApp {
             Ok(()) => self.inform(String::new()),
             Err(e) => self.complain(e),
         }
-        if !matches!(selection, Selection::Robot(_)) {
+        if !tool_fits(self.view.tool, Some(&selection)) {
             self.view.tool = tools::Tool::Select;
         }
         self.selection = Some(selection);
@@ -346,12 +346,19 @@ impl RoboSimApp {
             C::ScrubTo(step) => self.runner.scrub_to(step),
             C::Fit => self.view.fit(),
             C::SetTool(tool) => {
+                if !tool_fits(tool, self.selection.as_ref()) {
+                    return self.complain(match tool {
+                        tools::Tool::Joint => "the joint tool works in a robot".into(),
+                        _ => "the drawing tools draw into a scene or a robot".into(),
+                    });
+                }
                 self.view.tool = tool;
-                if tool == tools::Tool::Joint {
+                if tool != tools::Tool::Select {
                     self.stop_at_start();
                 }
             }
             C::SetSnap(step) => self.view.snap_step = step,
+            C::SetShapeOptions(options) => self.view.shape = options,
             C::SetDebug(debug) => self.view.debug = debug,
             C::Follow(body) => self.follow(body),
             C::ToggleProblems => self.show_problems = !self.show_problems,
@@ -401,6 +408,9 @@ impl RoboSimApp {
             A::Reset => Command::Reset,
             A::Fit => Command::Fit,
             A::ShowShortcuts => Command::ShowShortcuts,
+            A::SelectTool => Command::SetTool(tools::Tool::Select),
+            A::BoxTool => Command::SetTool(tools::Tool::Box),
+            A::PolygonTool => Command::SetTool(tools::Tool::Polygon),
             A::RotateLeft | A::RotateRight => {
                 let i = self.followed.filter(|_| self.runner.editing())?;
                 let turn = if action == A::RotateRight { 1.0 } else { -1.0 };
@@ -453,6 +463,7 @@ impl RoboSimApp {
             can_paste: self.copied.is_some(),
             tool: self.view.tool,
             snap_step: self.view.snap_step,
+            shape: self.view.shape,
             debug: self.view.debug,
         }
     }
@@ -590,12 +601,25 @@ impl RoboSimApp {
     }
 }
 
+/// Whether `tool` works on what `selection` shows: joints in robots, drawing in scenes
+/// and robots.
+fn tool_fits(tool: tools::Tool, selection: Option<&Selection>) -> bool {
+    match tool {
+        tools::Tool::Select => true,
+        tools::Tool::Joint => matches!(selection, Some(Selection::Robot(_))),
+        tools::Tool::Box | tools::Tool::Polygon => {
+            matches!(selection, Some(Selection::Robot(_) | Selection::Scene(_)))
+        }
+    }
+}
+
 impl eframe::App for RoboSimApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         let typing = ctx.text_edit_focused();
         let (frame_seconds, now) = ui.input(|i| (i.stable_dt as f64, i.time));
-        let actions = ui.input_mut(|i| shortcuts::pressed(i, typing));
+        let tool_on = self.view.tool != tools::Tool::Select;
+        let actions = ui.input_mut(|i| shortcuts::pressed(i, typing, tool_on));
         for action in actions {
             if let Some(command) = self.action(action) {
                 self.apply(command, &ctx, now);

@@ -31,6 +31,9 @@ pub enum Action {
     /// At step 0, the selection a grid step right.
     Right,
     ShowShortcuts,
+    SelectTool,
+    BoxTool,
+    PolygonTool,
 }
 
 const fn command(key: Key) -> KeyboardShortcut {
@@ -117,6 +120,21 @@ pub const SHORTCUTS: &[(Action, KeyboardShortcut, &str)] = &[
         plain(Key::ArrowRight),
         "At step 0: move the selection right one grid step",
     ),
+    (
+        Action::BoxTool,
+        plain(Key::B),
+        "Box tool: drag on the canvas to draw a new body (scene or robot)",
+    ),
+    (
+        Action::PolygonTool,
+        plain(Key::P),
+        "Polygon tool: drag from the centre out to draw a regular polygon",
+    ),
+    (
+        Action::SelectTool,
+        plain(Key::Escape),
+        "Back to the select tool",
+    ),
     (Action::ShowShortcuts, plain(Key::F1), "This list"),
 ];
 
@@ -130,9 +148,14 @@ pub fn of(action: Action) -> Option<KeyboardShortcut> {
 
 /// The actions pressed this frame, consumed so that no widget also sees them. While a text
 /// field has the focus, keys without Ctrl type into it and Ctrl+Z/Y undo the typing.
-pub fn pressed(input: &mut egui::InputState, typing: bool) -> Vec<Action> {
+/// Escape is taken only while a tool other than select is on (`tool_on`): otherwise it
+/// stays egui's, which closes menus and popups with it.
+pub fn pressed(input: &mut egui::InputState, typing: bool, tool_on: bool) -> Vec<Action> {
     let mut actions = Vec::new();
     for (action, shortcut, _) in SHORTCUTS {
+        if *action == Action::SelectTool && !tool_on {
+            continue;
+        }
         let needs_command = shortcut.modifiers.command;
         if typing && (!needs_command || matches!(action, Action::Undo | Action::Redo)) {
             continue;

@@ -28,6 +28,7 @@ pub struct State<'a> {
     pub can_paste: bool,
     pub tool: Tool,
     pub snap_step: Option<f64>,
+    pub shape: tools::ShapeOptions,
     pub debug: DebugDraw,
 }
 
@@ -69,6 +70,7 @@ impl Toolbar {
             ui.menu_button("File", |ui| self.file_menu(ui, s, &mut out));
             ui.menu_button("Edit", |ui| edit_menu(ui, s, &mut out));
             ui.menu_button("View", |ui| view_menu(ui, s, &mut out));
+            ui.menu_button("Tools", |ui| tools_menu(ui, s, &mut out));
             ui.menu_button("Help", |ui| {
                 if entry(
                     ui,
@@ -217,7 +219,7 @@ impl Toolbar {
             .add(
                 egui::TextEdit::singleline(&mut self.path_input)
                     .hint_text("database folder")
-                    .desired_width(140.0),
+                    .desired_width(100.0),
             )
             .labelled_by(label.id)
             .on_hover_text("Type a folder and press Enter (for machines without a file dialog)");
@@ -252,12 +254,6 @@ impl Toolbar {
                 "Redo",
                 "Redo (Ctrl+Shift+Z or Ctrl+Y)",
                 Command::Redo,
-            ),
-            (
-                s.has_folder && s.dirty,
-                "Revert",
-                "Reload the files, dropping unsaved edits (undoable)",
-                Command::Revert,
             ),
         ] {
             if ui
@@ -352,6 +348,24 @@ fn view_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
     }
 }
 
+/// The polygon's sides and the terrain box, beside the drawing tools.
+fn shape_options(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    let mut options = s.shape;
+    if s.tool == Tool::Polygon {
+        let label = ui.label("sides");
+        ui.add(egui::DragValue::new(&mut options.sides).range(tools::POLYGON_SIDES))
+            .labelled_by(label.id)
+            .on_hover_text("The polygon tool's number of sides");
+    }
+    if matches!(s.selection, Some(Selection::Scene(_))) {
+        ui.checkbox(&mut options.terrain, "static")
+            .on_hover_text("Draw static terrain (density 0) instead of a moving body (density 1)");
+    }
+    if options != s.shape {
+        out.push(Command::SetShapeOptions(options));
+    }
+}
+
 fn debug_checkboxes(ui: &mut egui::Ui, debug: &mut DebugDraw) {
     ui.checkbox(&mut debug.contacts, "Contact points and normals");
     ui.checkbox(&mut debug.joints, "Joint anchors and gaps");
@@ -423,23 +437,88 @@ fn clock(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
     }
 }
 
-/// The joint tool, snapping, Follow and the debug overlays.
+/// A tool as the Tools menu and the toolbar offer it.
+struct ToolEntry {
+    tool: Tool,
+    /// Whether it works on what is shown.
+    enabled: bool,
+    /// In the menu, and (short) in the toolbar.
+    text: &'static str,
+    short: &'static str,
+    action: Option<Action>,
+    tip: &'static str,
+}
+
+fn tool_entries(s: State<'_>) -> [ToolEntry; 4] {
+    let robot = matches!(s.selection, Some(Selection::Robot(_)));
+    let scene_or_robot = robot || matches!(s.selection, Some(Selection::Scene(_)));
+    [
+        ToolEntry {
+            tool: Tool::Select,
+            enabled: true,
+            text: "Select",
+            short: "Select",
+            action: Some(Action::SelectTool),
+            tip: "Click a body to select it, drag on empty space to select several; drag to move them",
+        },
+        ToolEntry {
+            tool: Tool::Box,
+            enabled: scene_or_robot,
+            text: "Draw box",
+            short: "Box",
+            action: Some(Action::BoxTool),
+            tip: "Draw a box: drag from corner to corner on the canvas for a new body of that size, placed there (paused at step 0)",
+        },
+        ToolEntry {
+            tool: Tool::Polygon,
+            enabled: scene_or_robot,
+            text: "Draw polygon",
+            short: "Polygon",
+            action: Some(Action::PolygonTool),
+            tip: "Draw a regular polygon: drag from the centre out for a new body of that radius, placed there (paused at step 0)",
+        },
+        ToolEntry {
+            tool: Tool::Joint,
+            enabled: robot,
+            text: "Add joint",
+            short: "Add joint",
+            action: None,
+            tip: "Pin two bodies together: click a point where they overlap (paused at step 0)",
+        },
+    ]
+}
+
+fn tools_menu(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
+    for t in tool_entries(s) {
+        if entry(ui, t.enabled, t.text, t.action, t.tip) {
+            out.push(Command::SetTool(t.tool));
+        }
+    }
+}
+
+/// The tools, the drawing tools' options, snapping and Follow.
 fn tools_and_view(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
-    if matches!(s.selection, Some(Selection::Robot(_))) {
-        let joint = s.tool == Tool::Joint;
+    // No Select button, to keep the bar on one line: a tool's button (or Esc) turns it off.
+    for t in tool_entries(s) {
+        if !t.enabled || t.tool == Tool::Select {
+            continue;
+        }
+        let key = t
+            .action
+            .and_then(shortcuts::of)
+            .map(|k| format!(" ({})", ui.ctx().format_shortcut(&k)))
+            .unwrap_or_default();
+        let on = s.tool == t.tool;
         if ui
-            .selectable_label(joint, "Add joint")
-            .on_hover_text(
-                "Pin two bodies together: click a point where they overlap (paused at step 0)",
-            )
+            .selectable_label(on, t.short)
+            .on_hover_text(format!("{}{key}; click again to select", t.tip))
             .clicked()
         {
-            out.push(Command::SetTool(if joint {
-                Tool::Select
-            } else {
-                Tool::Joint
-            }));
+            out.push(Command::SetTool(if on { Tool::Select } else { t.tool }));
         }
+    }
+    if s.tool.draws() {
+        shape_options(ui, s, out);
     }
     let mut snap = s.snap_step;
     egui::ComboBox::from_id_salt("snap")
@@ -459,14 +538,10 @@ fn tools_and_view(ui: &mut egui::Ui, s: State<'_>, out: &mut Vec<Command>) {
     if snap != s.snap_step {
         out.push(Command::SetSnap(snap));
     }
+    // The debug overlays are in the View menu: the bar keeps to one line at 1280 points.
     let mut debug = s.debug;
     ui.toggle_value(&mut debug.follow, "Follow")
         .on_hover_text("Keep the moving bodies in view (panning turns it off)");
-    ui.menu_button("Debug draw", |ui| debug_checkboxes(ui, &mut debug))
-        .response
-        .on_hover_text(
-            "Overlays on the canvas: contacts, joints, bounds, centres, velocities, sleep, islands",
-        );
     if debug != s.debug {
         out.push(Command::SetDebug(debug));
     }

@@ -2,8 +2,9 @@
 //! at a point, snapping to the grid. The canvas turns clicks into calls; tests call them
 //! directly.
 
+use super::Selection;
 use crate::db::outline_polygon;
-use crate::model::{JointDef, Model, Placement, Robot, same_name};
+use crate::model::{BodyDef, JointDef, Model, Placement, Robot, RobotBody, same_name};
 use pe::Vec2;
 
 /// What a click on the canvas does in a robot or scene (the body editor has its own).
@@ -14,6 +15,168 @@ pub enum Tool {
     Select,
     /// Robots only: a click on a point covered by two bodies pins them together there.
     Joint,
+    /// A drag from corner to corner draws a box: a new body, placed where it was drawn.
+    Box,
+    /// A drag from the centre out draws a regular polygon of that circumradius.
+    Polygon,
+}
+
+impl Tool {
+    /// Whether the tool draws new bodies (at step 0, into a scene or a robot).
+    pub fn draws(self) -> bool {
+        matches!(self, Tool::Box | Tool::Polygon)
+    }
+}
+
+/// How the drawing tools shape and make their bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeOptions {
+    /// The polygon tool's number of sides.
+    pub sides: u32,
+    /// Draw static terrain (density 0) instead of a moving body (density 1).
+    pub terrain: bool,
+}
+
+impl Default for ShapeOptions {
+    fn default() -> Self {
+        Self {
+            sides: 6,
+            terrain: false,
+        }
+    }
+}
+
+/// The sides the polygon tool offers.
+pub const POLYGON_SIDES: std::ops::RangeInclusive<u32> = 3..=12;
+
+/// A body drawn on the canvas: its outline about its own origin, and where that origin
+/// goes (in the scene's or the robot's frame).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DrawnShape {
+    pub vertices: Vec<[f64; 2]>,
+    pub at: Vec2,
+    /// The start of its name: "box", "hexagon", …
+    pub kind: String,
+}
+
+/// Drawn shapes smaller than this (world units) are refused: a slip, not a body.
+const SMALLEST_DRAWN: f64 = 1.0;
+
+/// The shape `tool` draws for a drag from `from` to `to`, or why there is none.
+pub fn drawn_shape(
+    tool: Tool,
+    options: ShapeOptions,
+    from: Vec2,
+    to: Vec2,
+) -> Result<DrawnShape, String> {
+    match tool {
+        Tool::Box => {
+            let size = (to - from).abs();
+            if size.x < SMALLEST_DRAWN || size.y < SMALLEST_DRAWN {
+                return Err("drag further: a box needs a width and a height".into());
+            }
+            let (w, h) = (size.x / 2.0, size.y / 2.0);
+            Ok(DrawnShape {
+                vertices: vec![[-w, -h], [w, -h], [w, h], [-w, h]],
+                at: (from + to) / 2.0,
+                kind: "box".into(),
+            })
+        }
+        Tool::Polygon => {
+            let r = (to - from).norm();
+            if r < SMALLEST_DRAWN {
+                return Err("drag further: the drag from the centre sets the radius".into());
+            }
+            let n = options
+                .sides
+                .clamp(*POLYGON_SIDES.start(), *POLYGON_SIDES.end());
+            Ok(DrawnShape {
+                vertices: regular_polygon(n, r),
+                at: from,
+                kind: polygon_name(n),
+            })
+        }
+        Tool::Select | Tool::Joint => Err("this tool draws nothing".into()),
+    }
+}
+
+/// A regular `n`-gon of circumradius `r` about the origin, with a flat edge at the bottom
+/// (+y, down on screen) so that it rests on the ground as drawn; vertices in the order of
+/// the app's other outlines, to a thousandth.
+pub fn regular_polygon(n: u32, r: f64) -> Vec<[f64; 2]> {
+    use std::f64::consts::{FRAC_PI_2, PI, TAU};
+    let start = FRAC_PI_2 + PI / n as f64;
+    let round = |v: f64| (v * 1000.0).round() / 1000.0;
+    (0..n)
+        .map(|k| {
+            let a = start + TAU * k as f64 / n as f64;
+            [round(r * a.cos()), round(r * a.sin())]
+        })
+        .collect()
+}
+
+fn polygon_name(n: u32) -> String {
+    match n {
+        3 => "triangle".into(),
+        4 => "square".into(),
+        5 => "pentagon".into(),
+        6 => "hexagon".into(),
+        7 => "heptagon".into(),
+        8 => "octagon".into(),
+        _ => format!("{n}-gon"),
+    }
+}
+
+/// Adds `shape` as a new body definition (density 1, or 0 as `terrain`) and places it
+/// where it was drawn in scene or robot `into`. Its name is the first "kind k" that is
+/// neither a body's name nor a placement's alias there, so that both can be the same.
+/// Returns the name.
+pub fn add_drawn_body(
+    model: &mut Model,
+    into: &Selection,
+    shape: DrawnShape,
+    terrain: bool,
+) -> Result<String, String> {
+    let aliases: Vec<String> = match into {
+        Selection::Scene(n) => model
+            .scene(n)
+            .map(|s| s.bodies.iter().map(|b| b.alias.clone()).collect()),
+        Selection::Robot(n) => model
+            .robot(n)
+            .map(|r| r.bodies.iter().map(|b| b.placement.alias.clone()).collect()),
+        Selection::Body(_) => None,
+    }
+    .ok_or("draw into a scene or a robot")?;
+    let name = (1..)
+        .map(|k| format!("{} {k}", shape.kind))
+        .find(|c| model.body(c).is_none() && !aliases.iter().any(|a| same_name(a, c)))
+        .expect("some number is free");
+    model.bodies.push(BodyDef {
+        name: name.clone(),
+        density: if terrain { 0.0 } else { 1.0 },
+        // The restitution of the app's other new bodies.
+        cor: 0.2,
+        vertices: shape.vertices,
+        ..BodyDef::default()
+    });
+    let placement = Placement {
+        alias: name.clone(),
+        source: name.clone(),
+        x: shape.at.x,
+        y: shape.at.y,
+        ..Placement::default()
+    };
+    match into {
+        Selection::Scene(n) => model.scene_mut(n).map(|s| s.bodies.push(placement)),
+        Selection::Robot(n) => model.robot_mut(n).map(|r| {
+            r.bodies.push(RobotBody {
+                placement,
+                motors: Vec::new(),
+            })
+        }),
+        Selection::Body(_) => None,
+    };
+    Ok(name)
 }
 
 /// Grid spacings offered for snapping (world units); `None` is off.
@@ -146,7 +309,6 @@ pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDe
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{BodyDef, RobotBody};
 
     fn square() -> Vec<[f64; 2]> {
         vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]
@@ -170,6 +332,29 @@ mod tests {
         }
         assert_eq!(drawn.len(), 3);
         assert!(outline_polygon(&drawn).is_ok());
+    }
+
+    #[test]
+    fn a_drawn_polygon_is_regular_convex_and_flat_at_the_bottom() {
+        let hexagon = regular_polygon(6, 10.0);
+        assert_eq!(hexagon.len(), 6);
+        assert!(outline_polygon(&hexagon).is_ok());
+        for v in &hexagon {
+            assert!((v[0].hypot(v[1]) - 10.0).abs() < 1e-3, "{v:?}");
+        }
+        // The two lowest vertices (largest y) are level.
+        let mut ys: Vec<f64> = hexagon.iter().map(|v| v[1]).collect();
+        ys.sort_by(f64::total_cmp);
+        assert_eq!(ys[4], ys[5]);
+        let square = regular_polygon(4, 2f64.sqrt());
+        assert_eq!(square, [[-1.0, 1.0], [-1.0, -1.0], [1.0, -1.0], [1.0, 1.0]]);
+        let slip = drawn_shape(
+            Tool::Box,
+            ShapeOptions::default(),
+            Vec2::zeros(),
+            Vec2::new(5.0, 0.5),
+        );
+        assert!(slip.is_err());
     }
 
     #[test]

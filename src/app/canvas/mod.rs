@@ -7,7 +7,7 @@ pub mod draw;
 
 use super::Command;
 use super::camera::Camera;
-use super::tools::Tool;
+use super::tools::{self, ShapeOptions, Tool};
 use super::world_bound::WorldBound;
 use crate::sim::Simulation;
 use egui::{Color32, PointerButton, Rect, Sense, Stroke};
@@ -93,6 +93,11 @@ pub struct CanvasView {
     pub snap_step: Option<f64>,
     /// The vertex being dragged in the body editor.
     pub vertex_drag: Option<usize>,
+    /// How the drawing tools shape their bodies.
+    pub shape: ShapeOptions,
+    /// The drag of a drawing tool: where it started and where the pointer is (world,
+    /// snapped).
+    pub drawing: Option<(Vec2, Vec2)>,
     /// The rubber band being dragged out on empty canvas: where the drag started and
     /// where the pointer is (screen points).
     pub band: Option<(egui::Pos2, egui::Pos2)>,
@@ -110,6 +115,8 @@ impl Default for CanvasView {
             snap_step: Some(0.5),
             vertex_drag: None,
             band: None,
+            shape: ShapeOptions::default(),
+            drawing: None,
         }
     }
 }
@@ -173,6 +180,7 @@ impl CanvasView {
         let mut commands = Vec::new();
         let followed = self.pointer(ui, &response, scene, grab, &mut commands);
         self.rubber_band(ui, &response, scene, &mut commands);
+        self.draw_gesture(ui, &response, scene, &mut commands);
         // A click this frame shows at once what it selected; the app's selection next frame.
         let selected: Vec<usize> = if followed == scene.followed {
             scene.picked.to_vec()
@@ -200,6 +208,7 @@ impl CanvasView {
                 egui::StrokeKind::Inside,
             );
         }
+        self.drawing_preview(&painter);
         self.hints(ui, &painter, scene);
         commands
     }
@@ -252,7 +261,7 @@ impl CanvasView {
         let pressed = pressed_screen.map(|p| camera.to_world(rect, p));
         let drag_started = response.drag_started_by(PointerButton::Primary);
         let selecting = !scene.editing || self.tool == Tool::Select;
-        if scene.editing && !selecting && response.clicked() {
+        if scene.editing && self.tool == Tool::Joint && response.clicked() {
             commands.extend(pointer.map(Command::UseTool));
         }
         let turning_id = response.id.with("turning");
@@ -351,6 +360,84 @@ impl CanvasView {
         }
     }
 
+    /// At step 0 with a drawing tool, a drag sizes a new body (from corner to corner, or
+    /// from the centre out); on release the app makes it and places it there.
+    fn draw_gesture(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        scene: Scene<'_>,
+        commands: &mut Vec<Command>,
+    ) {
+        if !scene.editing || !self.tool.draws() {
+            self.drawing = None;
+            return;
+        }
+        let (camera, rect) = (self.camera, self.rect);
+        let snap = |p: Vec2| {
+            Vec2::new(
+                tools::snap(p.x, self.snap_step),
+                tools::snap(p.y, self.snap_step),
+            )
+        };
+        if response.drag_started_by(PointerButton::Primary) {
+            let start = ui.input(|i| i.pointer.press_origin());
+            self.drawing = start.map(|p| {
+                let w = snap(camera.to_world(rect, p));
+                (w, w)
+            });
+        } else if response.clicked() {
+            commands.push(Command::Inform(
+                "drag to draw: a box from corner to corner, a polygon from its centre out".into(),
+            ));
+        }
+        let Some((from, to)) = self.drawing.as_mut() else {
+            return;
+        };
+        if let Some(p) = response.interact_pointer_pos() {
+            *to = snap(camera.to_world(rect, p));
+        }
+        if response.drag_stopped() || !ui.input(|i| i.pointer.primary_down()) {
+            commands.push(Command::DrawShape {
+                from: *from,
+                to: *to,
+            });
+            self.drawing = None;
+        }
+    }
+
+    /// The outline a drawing drag would make, with its size.
+    fn drawing_preview(&self, painter: &egui::Painter) {
+        let Some((from, to)) = self.drawing else {
+            return;
+        };
+        let Ok(shape) = tools::drawn_shape(self.tool, self.shape, from, to) else {
+            return;
+        };
+        let points: Vec<egui::Pos2> = shape
+            .vertices
+            .iter()
+            .map(|v| {
+                self.camera
+                    .to_screen(self.rect, shape.at + Vec2::new(v[0], v[1]))
+            })
+            .collect();
+        let label = points.iter().fold(egui::Pos2::ZERO, |m, p| m.max(*p));
+        painter.add(egui::Shape::closed_line(points, Stroke::new(1.5, BAND)));
+        let size = (to - from).abs();
+        let text = match self.tool {
+            Tool::Box => format!("{} × {}", size.x, size.y),
+            _ => format!("r {:.1}", (to - from).norm()),
+        };
+        painter.text(
+            label + egui::vec2(6.0, 6.0),
+            egui::Align2::LEFT_TOP,
+            text,
+            egui::FontId::proportional(13.0),
+            BAND,
+        );
+    }
+
     /// Where the rotate handle of body `i` is on screen: above its outline.
     fn handle(&self, sim: &Simulation, i: Option<usize>) -> Option<egui::Pos2> {
         let body = sim.bodies.get(i?).and_then(|b| sim.world.body(b.handle))?;
@@ -399,9 +486,13 @@ impl CanvasView {
         }
         let hint = match self.tool {
             Tool::Select => {
-                "editing at step 0: drag a body to move it · drag on empty space to select several (Shift adds) · drag the handle or Q / E to turn · Play runs"
+                "step 0: drag a body to move it · drag on empty space to select several (Shift adds) · handle or Q / E turns · Play runs"
             }
             Tool::Joint => "joint tool: click a point where two bodies overlap to pin them there",
+            Tool::Box => "box tool: drag from corner to corner to draw a new body · Esc selects",
+            Tool::Polygon => {
+                "polygon tool: drag from the centre out to draw a new body · Esc selects"
+            }
         };
         painter.text(
             self.rect.left_top() + egui::vec2(8.0, 8.0),

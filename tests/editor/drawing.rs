@@ -1,0 +1,116 @@
+//! The drawing tools: a box or a regular polygon dragged out on the canvas becomes a new
+//! body definition placed where it was drawn, in a scene or a robot, as one undo step.
+
+use super::{drag_world, harness, scratch_db, stop_at_step_0};
+use egui::{Key, Modifiers};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use robosim::app::{RoboSimApp, Selection};
+
+fn undo(h: &mut Harness<'_, RoboSimApp>) {
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.run_steps(2);
+}
+
+#[test]
+fn a_box_dragged_into_a_scene_is_a_new_body_placed_there_and_one_undo_takes_both() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    stop_at_step_0(&mut h);
+    let before = h.state().model().clone();
+    h.key_press(Key::B);
+    h.run_steps(2);
+    // From corner (600, 200) to (640, 230): a 40 × 30 box centred at (620, 215).
+    drag_world(&mut h, (600.0, 200.0), (640.0, 230.0));
+    let model = h.state().model().clone();
+    assert_eq!(
+        model.bodies.len(),
+        before.bodies.len() + 1,
+        "{}",
+        h.state().status()
+    );
+    // "box 1" … "box 8" are the scene's aliases already: the first free name is "box 9".
+    let body = model.body("box 9").expect("a body named box 9");
+    assert_eq!(
+        body.vertices,
+        [[-20.0, -15.0], [20.0, -15.0], [20.0, 15.0], [-20.0, 15.0]]
+    );
+    assert_eq!((body.density, body.cor), (1.0, 0.2));
+    let scene = model.scene("stack of boxes").unwrap();
+    let placed = scene.bodies.last().unwrap();
+    assert_eq!(
+        (
+            placed.alias.as_str(),
+            placed.source.as_str(),
+            placed.x,
+            placed.y
+        ),
+        ("box 9", "box 9", 620.0, 215.0)
+    );
+    assert_eq!(
+        scene.bodies.len(),
+        before.scene("stack of boxes").unwrap().bodies.len() + 1
+    );
+    // It simulates where it was drawn, and is selected.
+    let sim = h.state().sim().unwrap();
+    let i = sim.bodies.iter().position(|b| b.id == "box 9").unwrap();
+    let origin = sim.world.body(sim.bodies[i].handle).unwrap().origin();
+    assert_eq!((origin.x, origin.y), (620.0, 215.0));
+    assert_eq!(h.state().picked(), [i]);
+    undo(&mut h);
+    assert_eq!(
+        *h.state().model(),
+        before,
+        "one undo removes the body and its placement"
+    );
+
+    // Static terrain: the checkbox beside the tool, density 0.
+    click_label(&mut h, "static");
+    drag_world(&mut h, (600.0, 200.0), (700.0, 210.0));
+    let terrain = h.state().model().body("box 9").unwrap().clone();
+    assert_eq!(terrain.density, 0.0);
+    // A slip (a drag too thin to be a box) makes nothing and says why.
+    let count = h.state().model().bodies.len();
+    drag_world(&mut h, (600.0, 100.0), (650.0, 100.2));
+    assert_eq!(h.state().model().bodies.len(), count);
+    assert!(
+        h.state().status().contains("drag further"),
+        "{}",
+        h.state().status()
+    );
+}
+
+fn click_label(h: &mut Harness<'_, RoboSimApp>, label: &str) {
+    h.get_by_label(label).click();
+    h.run_steps(2);
+}
+
+#[test]
+fn a_polygon_dragged_into_a_robot_is_a_regular_body_of_that_radius_in_the_robot() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label_contains("housenka ·").click();
+    h.run_steps(2);
+    assert!(matches!(h.state().selection(), Some(Selection::Robot(_))));
+    let before = h.state().model().clone();
+    click_label(&mut h, "Polygon");
+    // From the centre (0, -60) out 25 to the right: a hexagon of circumradius 25.
+    drag_world(&mut h, (0.0, -60.0), (25.0, -60.0));
+    let model = h.state().model().clone();
+    let body = model.body("hexagon 1").expect("a body named hexagon 1");
+    assert_eq!(body.vertices.len(), 6);
+    for v in &body.vertices {
+        assert!((v[0].hypot(v[1]) - 25.0).abs() < 1e-3, "{v:?}");
+    }
+    assert_eq!(body.density, 1.0);
+    let robot = model.robot("housenka").unwrap();
+    let placed = &robot.bodies.last().unwrap().placement;
+    assert_eq!(
+        (placed.alias.as_str(), placed.x, placed.y),
+        ("hexagon 1", 0.0, -60.0)
+    );
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+}
