@@ -1,0 +1,365 @@
+//! The step's candidate pairs: the collision filter (joints and ignored pairs), the
+//! broad phase over bounds grown by each body's reach, and the cap on a crowded body's
+//! neighbours.
+
+use super::World;
+use crate::body::Body;
+use crate::collide::reuse::Pose;
+use crate::collide::{Aabb, WorldPolygon};
+use crate::math::Vec2;
+
+/// While the broad phase pairs the bodies again every time, every this many pairings use
+/// grown bounds, to see whether they hold again (`find_candidate_pairs`).
+const RETRY_GROWN_BOUNDS: u32 = 8;
+
+/// nearer ones stand between.
+const MAX_NEIGHBOURS: f64 = 32.0;
+
+/// How much of body `i`'s room for neighbours body `j` takes: 1 for a body at least its
+/// size, by bounding radius, and less for a smaller one.
+fn neighbour_share(radii: &[f64], i: usize, j: usize) -> f64 {
+    if radii[j] >= radii[i] {
+        1.0
+    } else {
+        radii[j] / radii[i]
+    }
+}
+
+/// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
+/// `pairs`, counted by `neighbour_share` into `room_taken`.
+fn crowded(pairs: &[(u32, u32)], fixed: &[bool], radii: &[f64], room_taken: &mut Vec<f64>) -> bool {
+    room_taken.clear();
+    room_taken.resize(fixed.len(), 0.0);
+    let mut crowded = false;
+    for &(i, j) in pairs {
+        let (i, j) = (i as usize, j as usize);
+        if !fixed[i] && !fixed[j] {
+            for (k, other) in [(i, j), (j, i)] {
+                room_taken[k] += neighbour_share(radii, k, other);
+                crowded |= room_taken[k] > MAX_NEIGHBOURS;
+            }
+        }
+    }
+    crowded
+}
+
+/// Scratch for `keep_nearest_neighbours`.
+#[derive(Debug, Clone, Default)]
+pub(super) struct NeighbourScratch {
+    room_taken: Vec<f64>,
+    dropped: Vec<bool>,
+    /// (gap, pair) for the pairs found only by how far their bodies can move.
+    within_reach: Vec<(f64, u32)>,
+}
+
+/// Keeps each pair with a fixed body, and pairs of moving bodies while both have room
+/// (`MAX_NEIGHBOURS`): first those whose own bounds overlap, in the pairs' order (in a
+/// pile-up they are all alike and all there is), then those found only by how far the
+/// bodies can move in the step, nearest first. `boxes` are the bounds grown by `grown_by`
+/// each.
+fn keep_nearest_neighbours(
+    pairs: &mut Vec<(u32, u32)>,
+    fixed: &[bool],
+    (boxes, grown_by, radii): (&[Option<Aabb>], &[f64], &[f64]),
+    scratch: &mut NeighbourScratch,
+) {
+    let NeighbourScratch {
+        room_taken,
+        dropped,
+        within_reach,
+    } = scratch;
+    room_taken.clear();
+    room_taken.resize(fixed.len(), 0.0);
+    dropped.clear();
+    dropped.resize(pairs.len(), false);
+    within_reach.clear();
+    let mut keep_if_room = |p: usize, (i, j): (usize, usize), dropped: &mut [bool]| {
+        let (share_i, share_j) = (neighbour_share(radii, i, j), neighbour_share(radii, j, i));
+        if room_taken[i] + share_i <= MAX_NEIGHBOURS && room_taken[j] + share_j <= MAX_NEIGHBOURS {
+            room_taken[i] += share_i;
+            room_taken[j] += share_j;
+        } else {
+            dropped[p] = true;
+        }
+    };
+    for (p, &(i, j)) in pairs.iter().enumerate() {
+        let (i, j) = (i as usize, j as usize);
+        if fixed[i] || fixed[j] {
+            continue;
+        }
+        let (Some(a), Some(b)) = (&boxes[i], &boxes[j]) else {
+            continue;
+        };
+        let apart = (b.min - a.max).sup(&(a.min - b.max));
+        // The gap between their own bounds, without the growth.
+        let gap = apart.x.max(apart.y) + grown_by[i] + grown_by[j];
+        if gap < 0.0 {
+            keep_if_room(p, (i, j), dropped);
+        } else {
+            within_reach.push((gap, p as u32));
+        }
+    }
+    within_reach.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    for &(_, p) in within_reach.iter() {
+        let (i, j) = pairs[p as usize];
+        keep_if_room(p as usize, (i as usize, j as usize), dropped);
+    }
+    let mut p = 0;
+    pairs.retain(|_| {
+        p += 1;
+        !dropped[p - 1]
+    });
+}
+
+/// How far two bodies can close on each other in a step, from each one's `motion`: their
+/// centroids' relative displacement and how far each one's spin carries its farthest point.
+impl World {
+    pub(super) fn refresh_collision_filter(&mut self) {
+        if !std::mem::take(&mut self.collision_filter_stale) {
+            return;
+        }
+        self.scratch.fat_boxes.clear();
+        self.scratch.fat_fixed.clear();
+        self.scratch.fat_pairs.clear();
+        self.jointed.clear();
+        self.jointed.extend(
+            self.joints
+                .iter()
+                .flatten()
+                .flat_map(|j| [Some(j.body_a.0), j.body_b.map(|b| b.0)])
+                .flatten(),
+        );
+        self.jointed.sort_unstable();
+        self.jointed.dedup();
+        self.non_colliding.rebuild(
+            self.joints
+                .iter()
+                .flatten()
+                .filter(|j| !j.collide_connected)
+                .filter_map(|j| {
+                    let (a, b) = (j.body_a.0, j.body_b?.0);
+                    Some((a.min(b), a.max(b)))
+                })
+                .chain(self.ignored_pairs.iter().copied()),
+        );
+    }
+
+    /// World outlines, each body's reach this step and poses, and the broad phase's
+    /// candidate pairs: bodies whose bounds, grown by the margin and by how far each can
+    /// move in `dt`, overlap (pairs of fixed bodies and pairs kept apart left out).
+    pub(super) fn find_candidate_pairs(&mut self, dt: f64) {
+        let s = &mut self.scratch;
+        s.polygons
+            .resize_with(self.bodies.len(), WorldPolygon::default);
+        s.boxes.clear();
+        s.reach.clear();
+        s.motion.clear();
+        s.poses.clear();
+        let margin = self.settings.contact_margin();
+        let is_fixed =
+            |body: &Option<Body>| body.as_ref().is_none_or(|b| b.is_static() || b.is_asleep());
+        // The grown bounds' pairs still hold every pair whose bounds overlap now if every
+        // body's bounds lie inside its grown ones, and the same bodies are fixed: checked
+        // as the bounds are made, in the one pass over the bodies.
+        let mut still_inside = s.fat_boxes.len() == self.bodies.len();
+        let mut same_fixed = s.fat_fixed.len() == self.bodies.len();
+        let bodies = self.bodies.iter().zip(s.polygons.iter_mut()).enumerate();
+        for (i, (body, polygon)) in bodies {
+            // The speed of its farthest point from the spin alone.
+            let spin = body
+                .as_ref()
+                .map_or(0.0, |b| b.angular_velocity.abs() * b.bounding_radius());
+            let velocity = body.as_ref().map_or(Vec2::zeros(), |b| b.velocity);
+            let reach = (velocity.norm() + spin) * dt;
+            s.reach.push(reach);
+            s.motion.push((velocity * dt, spin * dt));
+            let pose = body.as_ref().map_or(Pose::default(), Pose::of);
+            s.poses.push(pose);
+            let bounds = body.as_ref().map(|b| {
+                // The outline from the pose (one rotation per body, shared with reuse).
+                polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
+                polygon.aabb().grown(0.5 * margin + reach)
+            });
+            if still_inside {
+                still_inside = match (&bounds, &s.fat_boxes[i]) {
+                    (Some(now), Some(fat)) => fat.contains(now),
+                    (None, None) => true,
+                    _ => false,
+                };
+            }
+            same_fixed = same_fixed && s.fat_fixed[i] == is_fixed(body);
+            s.boxes.push(bounds);
+        }
+        let bodies = &self.bodies;
+        // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
+        // The broad phase leaves out such pairs only, not those of bodies held for one pass
+        // of `auto` (whose two passes hold different bodies); those are dropped from its
+        // pairs below, so that its pairs serve both passes.
+        if still_inside && same_fixed {
+            s.paired_in_a_row = 0;
+        } else {
+            s.paired_in_a_row = s.paired_in_a_row.wrapping_add(1);
+            // Grown bounds pay while their pairs hold for a few steps. Where every step pairs
+            // again anyway (the smash's flying debris) they only add pairs to compare and
+            // sort: pair the bounds as they are, and try grown ones again now and then in
+            // case the scene has settled. The candidates are the same either way.
+            let grow_pays =
+                s.paired_in_a_row < 2 || s.paired_in_a_row.is_multiple_of(RETRY_GROWN_BOUNDS);
+            let grow = if grow_pays {
+                self.settings.broad_phase_margin()
+            } else {
+                0.0
+            };
+            s.fat_boxes.clear();
+            s.fat_boxes
+                .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
+            s.fat_fixed.clear();
+            s.fat_fixed.extend(bodies.iter().map(is_fixed));
+            let (non_colliding, fixed) = (&self.non_colliding, &s.fat_fixed);
+            let wanted = |i: usize, j: usize| {
+                let both_fixed = fixed[i] & fixed[j];
+                !both_fixed && !non_colliding.contains((i as u32, j as u32))
+            };
+            s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
+            s.radii.clear();
+            s.radii.extend(
+                bodies
+                    .iter()
+                    .map(|b| b.as_ref().map_or(0.0, Body::bounding_radius)),
+            );
+            let room_taken = &mut s.neighbours.room_taken;
+            s.crowded = crowded(&s.fat_pairs, fixed, &s.radii, room_taken);
+        }
+        // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
+        let boxes = &s.boxes;
+        let overlap = |&(i, j): &(u32, u32)| match (&boxes[i as usize], &boxes[j as usize]) {
+            (Some(a), Some(b)) => a.overlaps(b),
+            _ => false,
+        };
+        s.pairs.clear();
+        if s.held.is_empty() {
+            s.pairs.extend(s.fat_pairs.iter().copied().filter(overlap));
+        } else {
+            s.fixed_now.clear();
+            s.fixed_now
+                .extend(bodies.iter().map(|b| b.as_ref().is_none_or(Body::is_fixed)));
+            let fixed_now = &s.fixed_now;
+            let one_moves = |&(i, j): &(u32, u32)| !(fixed_now[i as usize] & fixed_now[j as usize]);
+            s.pairs.extend(
+                s.fat_pairs
+                    .iter()
+                    .copied()
+                    .filter(|p| one_moves(p) && overlap(p)),
+            );
+        }
+        if s.crowded {
+            s.grown_by.clear();
+            s.grown_by
+                .extend(s.reach.iter().map(|reach| 0.5 * margin + reach));
+            let sizes = (&s.boxes[..], &s.grown_by[..], &s.radii[..]);
+            keep_nearest_neighbours(&mut s.pairs, &s.fat_fixed, sizes, &mut s.neighbours);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::overlapping_pairs;
+    use super::*;
+    use crate::body::BodyDef;
+    use crate::shape::ConvexPolygon;
+    use crate::solver::ContactSolver;
+
+    /// The broad phase keeps its pairs while bodies stay inside their grown bounds; the
+    /// candidates must still be exactly the pairs whose bounds overlap now.
+    #[test]
+    fn candidates_are_the_overlapping_pairs_while_the_broad_phase_keeps_its_pairs() {
+        let mut world = World::new(Vec2::zeros());
+        world.settings.contact_solver = ContactSolver::Soft;
+        let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        // A grid of boxes drifting slowly, each its own way: a few hundredths of a box
+        // per step, so that the grown bounds hold for some steps and not for others.
+        for i in 0..8 {
+            for j in 0..8 {
+                let (x, y) = (1.3 * i as f64, 1.3 * j as f64);
+                let v = Vec2::new(
+                    ((3 * i + j) % 5) as f64 - 2.0,
+                    ((i + 2 * j) % 5) as f64 - 2.0,
+                );
+                let def = BodyDef::new(square.clone(), 1.0).at(Vec2::new(x, y), 0.0);
+                world.add_body(def.velocity(v * 0.9, 0.3)).unwrap();
+            }
+        }
+        world
+            .add_body(
+                BodyDef::new(ConvexPolygon::rectangle(30.0, 1.0).unwrap(), 0.0)
+                    .at(Vec2::new(4.5, 11.0), 0.0),
+            )
+            .unwrap();
+        let dt = 1.0 / 60.0;
+        let (mut kept, mut found) = (0, 0);
+        for _ in 0..300 {
+            world.step(dt);
+            let before = world.scratch.fat_boxes.clone();
+            world.find_candidate_pairs(dt);
+            if world.scratch.fat_boxes == before {
+                kept += 1;
+            } else {
+                found += 1;
+            }
+            assert_eq!(world.scratch.pairs, overlapping_pairs(&world));
+        }
+        assert!(
+            kept > 20 && found > 20,
+            "pairs kept {kept} times, found {found} times"
+        );
+    }
+
+    /// Debris flying apart leaves its grown bounds every step, so the broad phase pairs
+    /// the bare bounds, trying grown ones every `RETRY_GROWN_BOUNDS` pairings; then the
+    /// debris is stopped, the grown bounds hold again and their pairs are kept. The
+    /// candidates are exactly the overlapping pairs throughout.
+    #[test]
+    fn candidates_are_the_overlapping_pairs_while_debris_outruns_its_grown_bounds() {
+        let mut world = World::new(Vec2::zeros());
+        world.settings.contact_solver = ContactSolver::Soft;
+        let square = ConvexPolygon::rectangle(0.5, 0.5).unwrap();
+        let mut handles = vec![];
+        for i in 0..10 {
+            for j in 0..10 {
+                let at = Vec2::new(0.6 * i as f64, 0.6 * j as f64);
+                // Outwards from the middle at up to 23 m/s: 0.4 m a step, four margins.
+                let velocity = (at - Vec2::new(2.7, 2.7)) * 6.0;
+                let def = BodyDef::new(square.clone(), 1.0).at(at, 0.2);
+                handles.push(world.add_body(def.velocity(velocity, 2.0)).unwrap());
+            }
+        }
+        let dt = 1.0 / 60.0;
+        let (mut bare, mut grown, mut kept) = (0, 0, 0);
+        for step in 0..60 {
+            if step == 40 {
+                for &h in &handles {
+                    let body = world.body_mut(h).unwrap();
+                    body.velocity = Vec2::zeros();
+                    body.angular_velocity = 0.0;
+                }
+            }
+            // The step's own broad phase, at the poses the step began with.
+            let before = world.scratch.fat_boxes.clone();
+            world.step(dt);
+            let s = &world.scratch;
+            if s.fat_boxes == before {
+                kept += 1;
+            } else if s.fat_boxes == s.boxes {
+                bare += 1;
+            } else {
+                grown += 1;
+            }
+            assert_eq!(s.pairs, overlapping_pairs(&world), "step {step}");
+        }
+        assert!(
+            bare > 30 && grown >= 5 && kept > 15,
+            "bare bounds paired {bare} times, grown {grown}, pairs kept {kept} times"
+        );
+    }
+}

@@ -1,0 +1,242 @@
+//! The stages of the impulse stage list (`sequential`, `thesis`, `exact`): joint
+//! repair and velocity correction, push-apart, the contact and joint solve, split
+//! impulses, bounces placed at impact, and the state saved to redo a step finer.
+
+use super::{MAX_SUBSTEPS, World};
+use crate::body::Body;
+use crate::solver::ContactSolver;
+use crate::solver::contact::{restitution_threshold, solve_sequential};
+use crate::solver::joint::JointMotor;
+use crate::solver::simultaneous::FrictionModel;
+use crate::solver::system::VelocityTargets;
+
+/// Fraction of the excess penetration the split-impulse pass removes per step: all of it
+/// at once overshoots in stacks, where pushes add up along the column.
+const SPLIT_IMPULSE_RATE: f64 = 0.4;
+
+impl World {
+    pub(super) fn for_each_motor(&mut self, f: impl Fn(&mut JointMotor)) {
+        self.joints
+            .iter_mut()
+            .flatten()
+            .filter_map(|j| j.motor.as_mut())
+            .for_each(f);
+    }
+
+    pub(super) fn save_state(&mut self) {
+        let saved = &mut self.scratch.saved_state;
+        saved.clear();
+        saved.extend(self.bodies.iter().map(|b| {
+            b.as_ref().map_or(Default::default(), |b| {
+                (b.position, b.angle, b.velocity, b.angular_velocity)
+            })
+        }));
+    }
+
+    pub(super) fn restore_state(&mut self) {
+        for (body, &(p, a, v, w)) in self.bodies.iter_mut().zip(&self.scratch.saved_state) {
+            if let Some(b) = body {
+                (b.position, b.angle, b.velocity, b.angular_velocity) = (p, a, v, w);
+            }
+        }
+    }
+
+    /// How many substeps this step needs: the joint prediction (SPEC §3.3) follows each
+    /// jointed body's rotation by ω·h, and past a quarter radian per step that is too far
+    /// from linear for the Newton steps to be trusted (a whipping chain tip turns a radian
+    /// per 1/60 s). Usually 1.
+    pub(super) fn substeps_for(&self, dt: f64) -> usize {
+        const MAX_TURN: f64 = 0.25;
+        let fastest = self
+            .joints
+            .iter()
+            .flatten()
+            .flat_map(|j| [Some(j.body_a), j.body_b])
+            .flatten()
+            .filter_map(|h| self.body(h))
+            .map(|b| b.angular_velocity.abs())
+            .fold(0.0, f64::max);
+        ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SUBSTEPS)
+    }
+
+    /// A speculative contact that bounces this step reverses while the bodies are still a
+    /// gap g apart, where they have not yet fallen the last g: the rebound keeps
+    /// (1 − e²)·g too much height. Moving the body down by that much (positions only) puts
+    /// the bounce's energy where an impact at the surface would. Only against static
+    /// bodies: between two free bodies the shift would change angular momentum about the
+    /// origin, and exact conservation is worth more there than this O(v·h) height error.
+    pub(super) fn place_bounces_at_impact(&mut self, dt: f64) {
+        let bounce_below = restitution_threshold(self.gravity, dt);
+        for k in 0..self.contacts.len() {
+            let c = self.contacts[k];
+            let first_of_pair = k == 0 || {
+                let p = &self.contacts[k - 1];
+                (p.body_a, p.body_b) != (c.body_a, c.body_b)
+            };
+            if !first_of_pair {
+                continue;
+            }
+            let pair = self.contacts[k..]
+                .iter()
+                .take_while(|p| (p.body_a, p.body_b) == (c.body_a, c.body_b));
+            let (mut gap, mut room) = (0.0, f64::INFINITY);
+            for p in pair {
+                if p.depth < 0.0 && p.normal_impulse > 0.0 && p.bounces(dt, bounce_below) {
+                    gap = f64::max(gap, (1.0 - p.restitution * p.restitution) * -p.depth);
+                }
+                // The shift may not push any of the pair's other points in: a body
+                // pivoting on one corner that bounces on the other must stay out at both.
+                room = room.min(-p.depth);
+            }
+            let gap = gap.min(room);
+            if gap <= 0.0 {
+                continue;
+            }
+            let is_fixed = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_fixed);
+            let (moving, direction) = match (is_fixed(c.body_a), is_fixed(c.body_b)) {
+                (false, true) => (c.body_a, -c.normal),
+                (true, false) => (c.body_b, c.normal),
+                _ => continue,
+            };
+            // Moving one part of a jointed mechanism would open its joints.
+            if self.jointed.binary_search(&moving).is_ok() {
+                continue;
+            }
+            if let Some(body) = self.bodies[moving as usize].as_mut() {
+                body.position += direction * gap;
+            }
+        }
+    }
+
+    /// The solver the impulse stage list runs as: `auto` runs it as `exact`.
+    fn impulse_solver(&self) -> ContactSolver {
+        match self.settings.contact_solver {
+            ContactSolver::Auto => ContactSolver::Exact,
+            solver => solver,
+        }
+    }
+
+    /// Broken joints move towards closing, by positions only.
+    pub(super) fn repair_broken_joints(&mut self, dt: f64) {
+        if self.joints.is_empty() {
+            return;
+        }
+        self.gather_solver_bodies();
+        let it = self.settings.joint_iterations(dt);
+        let s = &mut self.scratch;
+        s.joint_solver.repair_positions(
+            self.settings.joint_solver,
+            &mut s.joint_constraints,
+            &mut s.solver_bodies,
+            &it,
+        );
+        self.scatter_solver_bodies();
+    }
+
+    /// Stage 1: joints whose anchors drift apart stop drifting (SPEC eq. 40).
+    pub(super) fn correct_joint_velocities(&mut self, dt: f64) {
+        if self.joints.is_empty() {
+            return;
+        }
+        self.gather_solver_bodies();
+        let it = self.settings.joint_iterations(dt);
+        let s = &mut self.scratch;
+        s.joint_solver.correct_velocities(
+            self.settings.joint_solver,
+            &mut s.joint_constraints,
+            &mut s.solver_bodies,
+            &it,
+        );
+        self.scatter_solver_bodies();
+    }
+
+    /// The thesis removes overlap directly: each pair is pushed apart along its normal by
+    /// its depth, shared by inverse mass (SPEC §3.1). Positions only.
+    pub(super) fn push_apart(&mut self) {
+        if self.impulse_solver() == ContactSolver::Exact {
+            return; // the exact solver removes depth by split impulses instead
+        }
+        for m in &self.manifolds {
+            let depth = m.depth();
+            if depth <= 0.0 {
+                continue;
+            }
+            let (ia, ib) = (m.body_a.index(), m.body_b.index());
+            let inv_a = self.bodies[ia].as_ref().map_or(0.0, |b| b.inv_mass);
+            let inv_b = self.bodies[ib].as_ref().map_or(0.0, |b| b.inv_mass);
+            let total = inv_a + inv_b;
+            if total == 0.0 {
+                continue;
+            }
+            if let Some(a) = self.bodies[ia].as_mut() {
+                a.position += m.normal * (depth * inv_a / total);
+            }
+            if let Some(b) = self.bodies[ib].as_mut() {
+                b.position -= m.normal * (depth * inv_b / total);
+            }
+        }
+    }
+
+    /// Stages 5–6: contact impulses (with pins and motors in the exact solver), then joint
+    /// position prediction, then (exact solver) the split-impulse depth correction.
+    pub(super) fn solve_constraints(&mut self, dt: f64) {
+        let solver = self.impulse_solver();
+        self.gather_solver_bodies();
+        let s = &mut self.scratch;
+        let targets = VelocityTargets {
+            dt,
+            bounce_below: restitution_threshold(self.gravity, dt),
+            friction: true,
+            close_joint_gaps: true,
+        };
+        match solver {
+            ContactSolver::Sequential | ContactSolver::Soft | ContactSolver::Auto => {
+                s.simultaneous.reports.clear();
+                solve_sequential(
+                    &mut self.contacts,
+                    &mut s.solver_bodies,
+                    dt,
+                    targets.bounce_below,
+                )
+            }
+            ContactSolver::Thesis | ContactSolver::Exact => {
+                let model = if solver == ContactSolver::Thesis {
+                    FrictionModel::TwoStage
+                } else {
+                    FrictionModel::Coupled
+                };
+                s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
+                s.simultaneous.solve(
+                    model,
+                    &mut self.contacts,
+                    &mut s.joint_constraints,
+                    &mut s.solver_bodies,
+                    &targets,
+                );
+            }
+        }
+        if !s.joint_constraints.is_empty() {
+            let it = self.settings.joint_iterations(dt);
+            s.joint_solver.correct_positions(
+                self.settings.joint_solver,
+                &mut s.joint_constraints,
+                &mut s.solver_bodies,
+                dt,
+                &it,
+                solver == ContactSolver::Exact,
+            );
+        }
+        if solver == ContactSolver::Exact {
+            s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
+            s.simultaneous.separate(
+                &self.contacts,
+                &s.joint_constraints,
+                &mut s.solver_bodies,
+                dt,
+                self.settings.slop(),
+                SPLIT_IMPULSE_RATE,
+            );
+        }
+        self.scatter_solver_bodies();
+    }
+}

@@ -1,0 +1,64 @@
+//! Forces and integration: motor torques, velocities from gravity and forces, positions
+//! from velocities, and forces cleared after the step.
+
+use super::{Integrator, World};
+use crate::math::Vec2;
+
+impl World {
+    /// Stage 2: body motors add their torque (SPEC §4.4).
+    pub(super) fn apply_motor_torques(&mut self, dt: f64) {
+        for (handle, motor) in self.body_motors.iter_mut() {
+            let Some(Some(b)) = self.bodies.get_mut(handle.index()) else {
+                continue;
+            };
+            b.torque += motor.torque(self.step_count, b.angular_velocity, dt);
+        }
+    }
+
+    /// Gravity and accumulated forces change velocities (SPEC §3.4 steps 2–3).
+    pub(super) fn integrate_velocities(&mut self, dt: f64) {
+        self.scratch.start_velocities.clear();
+        self.scratch
+            .start_velocities
+            .extend(self.bodies.iter().map(|b| {
+                b.as_ref()
+                    .map_or((Vec2::zeros(), 0.0), |b| (b.velocity, b.angular_velocity))
+            }));
+        for b in self.bodies.iter_mut().flatten() {
+            if b.is_fixed() {
+                continue;
+            }
+            b.velocity += (self.gravity + b.force * b.inv_mass) * dt;
+            b.angular_velocity += b.torque * b.inv_inertia * dt;
+        }
+    }
+
+    /// Positions follow velocities (SPEC §3.4 step 7).
+    pub(super) fn integrate_positions(&mut self, dt: f64) {
+        let gravity = self.gravity;
+        let explicit = self.settings.integrator == Integrator::ExplicitEuler;
+        for b in self.bodies.iter_mut().flatten() {
+            if b.is_fixed() {
+                continue;
+            }
+            let (v, w) = if explicit {
+                // Undo this step's force contribution: the position uses the old velocity,
+                // plus whatever impulses (contacts, joints) changed since.
+                let force_dv = (gravity + b.force * b.inv_mass) * dt;
+                let force_dw = b.torque * b.inv_inertia * dt;
+                (b.velocity - force_dv, b.angular_velocity - force_dw)
+            } else {
+                (b.velocity, b.angular_velocity)
+            };
+            b.position += v * dt;
+            b.angle += w * dt;
+        }
+    }
+
+    pub(super) fn clear_forces(&mut self) {
+        for b in self.bodies.iter_mut().flatten() {
+            b.force = Vec2::zeros();
+            b.torque = 0.0;
+        }
+    }
+}

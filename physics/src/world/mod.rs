@@ -1,0 +1,815 @@
+//! The world and its step: a list of named stages (SPEC §3.4). This module holds the
+//! world's storage and API and the step's stage lists; each stage's work is in the
+//! module named for it.
+
+mod auto;
+mod candidates;
+mod contacts;
+mod continuous;
+mod impulses;
+mod integrate;
+mod settings;
+mod sleeping;
+mod solver_bodies;
+
+pub use settings::{Integrator, StepSettings};
+
+use auto::{IslandNeeds, LastMarking};
+use candidates::NeighbourScratch;
+use solver_bodies::GapTargets;
+
+use crate::body::{Body, BodyDef, BodyError, BodyHandle};
+use crate::collide::reuse::{ManifoldCache, Pose};
+use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon};
+use crate::math::Vec2;
+use crate::solver::contact::{Contact, restitution_threshold};
+use crate::solver::island::UnionFind;
+use crate::solver::joint::{Joint, JointBlockSolver, JointConstraint, JointHandle, JointMotor};
+use crate::solver::motor::{BodyMotor, MotorError};
+use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
+use crate::solver::soft::{SoftSettings, SoftStepSolver};
+use crate::solver::{ContactSolver, SolverBody};
+use crate::stage_clock::{self, Stage};
+
+/// A joint to be made: the bodies and the shared world point they pin together, given
+/// to [`World::add_joint`]. The two bodies turn freely about the pin unless a
+/// [`JointMotor`] drives them, and do not collide with each other unless
+/// `collide_connected` (a robot's parts overlap around their pins).
+///
+/// A wheel pinned to the world at its centre and driven by a motor at 2 rad/s, with an arm
+/// pinned to its rim:
+///
+/// ```
+/// use pe::{BodyDef, ConvexPolygon, JointDef, JointMotor, Vec2, World};
+///
+/// let mut world = World::new(Vec2::new(0.0, 9.81));
+/// let wheel = ConvexPolygon::regular(12, 0.5).unwrap();
+/// let wheel = world.add_body(BodyDef::new(wheel, 1.0)).unwrap();
+/// let arm = ConvexPolygon::rectangle(1.0, 0.2).unwrap();
+/// let arm = world.add_body(BodyDef::new(arm, 1.0).at(Vec2::new(0.5, 0.0), 0.0)).unwrap();
+///
+/// let mut axle = JointDef::new(wheel, None, Vec2::zeros());
+/// axle.motor = Some(JointMotor::new(2.0, 1000.0)); // target rad/s, most torque
+/// world.add_joint(axle).unwrap();
+/// let elbow = world.add_joint(JointDef::new(arm, Some(wheel), Vec2::new(0.5, 0.0))).unwrap();
+/// for _ in 0..60 {
+///     world.step(1.0 / 60.0);
+/// }
+/// let spin = world.body(wheel).unwrap().angular_velocity;
+/// assert!((spin - 2.0).abs() < 1e-6, "the motor holds its speed: {spin}");
+/// assert!(world.joint_gap(elbow).unwrap() < 1e-3, "the arm stays on the rim");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointDef {
+    pub body_a: BodyHandle,
+    /// `None` pins body A to the static world.
+    pub body_b: Option<BodyHandle>,
+    /// The pin, in world coordinates at the bodies' current placement.
+    pub anchor: Vec2,
+    pub collide_connected: bool,
+    pub motor: Option<JointMotor>,
+}
+
+impl JointDef {
+    /// Pins `body_a` to `body_b` (`None`: the static world) at the world point `anchor`,
+    /// with no motor, the two not colliding.
+    pub fn new(body_a: BodyHandle, body_b: Option<BodyHandle>, anchor: Vec2) -> Self {
+        Self {
+            body_a,
+            body_b,
+            anchor,
+            collide_connected: false,
+            motor: None,
+        }
+    }
+}
+
+/// Why a joint cannot be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JointError {
+    #[error("the joint refers to a body that does not exist")]
+    MissingBody,
+    #[error("a joint needs two different bodies")]
+    SameBody,
+    #[error("the joint anchor is not a finite point")]
+    NonFiniteAnchor,
+    #[error("the joint anchor coordinate {0:e} is beyond ±{1:e}")]
+    AnchorBeyond(f64, f64),
+    #[error("joint {0}")]
+    BadMotor(MotorError),
+}
+
+/// Why a step was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    #[error("the time step must be a finite number > 0, got {0}")]
+    BadTimeStep(f64),
+    #[error("gravity must be finite and within ±{max:e} per axis, got ({0}, {1})", max = crate::limits::GRAVITY)]
+    BadGravity(f64, f64),
+    #[error("the world's friction must be a number in [0, 1e6], got {0}")]
+    BadFriction(f64),
+    #[error(
+        "gravity carries a body {fall:e} from rest in one step, more than {limit:e} ({FALL_PER_STEP} length scales): bodies would fall through each other; take a smaller step"
+    )]
+    FallsTooFar { fall: f64, limit: f64 },
+    /// The step ended with a body's state non-finite or beyond `crate::limits` (an
+    /// absurd force, a collapse no solver can hold): the world's state is not to be
+    /// trusted, and further steps are pointless.
+    #[error("body {body} left the limits: its {what} is {value:.3e} (at most ±{limit:e})")]
+    StateBeyond {
+        body: u32,
+        what: &'static str,
+        value: f64,
+        limit: f64,
+    },
+}
+
+/// The farthest gravity may carry a body from rest in one step (g·h²), in length scales:
+/// beyond it bodies fall through each other between two contact searches (the sequential
+/// solver let a box through a floor twice its size from 37 length scales a step; every
+/// other solver holds at any gravity within `limits::GRAVITY`).
+pub const FALL_PER_STEP: f64 = 10.0;
+
+/// At most this many substeps per step (see `World::substeps_for`).
+const MAX_SUBSTEPS: usize = 8;
+
+/// A 2D world of rigid convex bodies, pin joints and motors: bodies are added from a
+/// [`BodyDef`], joints from a [`JointDef`], and [`World::step`] advances them all. The
+/// world has no up: gravity is a vector, and with y pointing down (as on a screen) it is
+/// `(0, 9.81)`. Handles index the world's bodies and joints and are never reused.
+///
+/// A pendulum: a 2 m bar pinned to the static world at one end swings down, its centre
+/// kept 1 m from the pin.
+///
+/// ```
+/// use pe::{BodyDef, ConvexPolygon, JointDef, Vec2, World};
+///
+/// let mut world = World::new(Vec2::new(0.0, 9.81));
+/// let bar = ConvexPolygon::rectangle(2.0, 0.1).unwrap();
+/// // The bar lies along +x from the pin at the origin.
+/// let bar = world.add_body(BodyDef::new(bar, 1.0).at(Vec2::new(1.0, 0.0), 0.0)).unwrap();
+/// let pin = world.add_joint(JointDef::new(bar, None, Vec2::zeros())).unwrap();
+/// for _ in 0..30 {
+///     world.step(1.0 / 60.0);
+/// }
+/// let centre = world.body(bar).unwrap().position;
+/// assert!(centre.y > 0.5, "it swung down: {centre:?}");
+/// assert!((centre.norm() - 1.0).abs() < 1e-3, "the pin holds: {centre:?}");
+/// assert!(world.joint_gap(pin).unwrap() < 1e-3);
+/// ```
+#[derive(Debug, Clone, Default)]
+pub struct World {
+    bodies: Vec<Option<Body>>,
+    pub gravity: Vec2,
+    /// Friction coefficient for contacts whose bodies set none (the scene's `friction`).
+    pub friction: f64,
+    pub settings: StepSettings,
+    step_count: u64,
+    joints: Vec<Option<Joint>>,
+    /// Body pairs `(i, j)`, `i < j`, that a joint or `ignore_collisions` keeps from
+    /// colliding.
+    non_colliding: PairSet,
+    /// Bodies with at least one joint, sorted.
+    jointed: Vec<u32>,
+    /// The joints or ignored pairs changed since `non_colliding` and `jointed` were built:
+    /// they are rebuilt once at the next step, not at every change (a scene of 20,000 pins
+    /// took 12 s to build with a sort per `add_joint`).
+    collision_filter_stale: bool,
+    /// Pairs kept apart by [`World::ignore_collisions`], besides the jointed ones.
+    ignored_pairs: Vec<(u32, u32)>,
+    body_motors: Vec<(BodyHandle, BodyMotor)>,
+    manifolds: Vec<Manifold>,
+    /// Each pipeline's manifolds kept for reuse (see `Pipeline`).
+    manifold_caches: [ManifoldCache; 2],
+    contacts: Vec<Contact>,
+    /// Per body: the island it fell asleep with (woken together).
+    sleep_labels: Vec<u32>,
+    /// Per body: under `auto`, the step until which its island stays on the soft step
+    /// (`keep_over_budget_on_soft`).
+    soft_until: Vec<u64>,
+    scratch: Scratch,
+}
+
+/// The two stage lists of a step: impulses (`sequential`, `thesis`, `exact`) and the soft
+/// step. Under `auto` both run in one step on different islands, each finding its own
+/// contacts, so each keeps its own manifolds for reuse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pipeline {
+    Impulses = 0,
+    Soft = 1,
+}
+
+/// Buffers reused from step to step so that stepping does not allocate.
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    /// Islands of bodies, for sleeping and for `auto`'s choice of solver.
+    island_union: UnionFind,
+    wake_labels: Vec<u32>,
+    wake_broad_phase: BroadPhase,
+    island_ready: Vec<bool>,
+    polygons: Vec<WorldPolygon>,
+    poses: Vec<Pose>,
+    boxes: Vec<Option<Aabb>>,
+    broad_phase: BroadPhase,
+    pairs: Vec<(u32, u32)>,
+    /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin` (or bare,
+    /// while grown ones do not hold), and which bodies were static or asleep then (see
+    /// `find_candidate_pairs`; emptied when they no longer stand).
+    fat_boxes: Vec<Option<Aabb>>,
+    fat_pairs: Vec<(u32, u32)>,
+    fat_fixed: Vec<bool>,
+    /// How many times in a row the broad phase has paired the bodies again (0: it kept its
+    /// pairs the last time).
+    paired_in_a_row: u32,
+    /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among the
+    /// broad phase's pairs, each body's bounding radius, and scratch for finding out.
+    crowded: bool,
+    radii: Vec<f64>,
+    grown_by: Vec<f64>,
+    neighbours: NeighbourScratch,
+    /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
+    fixed_now: Vec<bool>,
+    solver_bodies: Vec<SolverBody>,
+    /// How far each body can move this step, and the two parts of it: its centroid's
+    /// displacement at its current velocity, and how far its spin can carry its
+    /// farthest point.
+    reach: Vec<f64>,
+    motion: Vec<(Vec2, f64)>,
+    /// This step's manifolds' gaps less what their bodies can close of them, and how far
+    /// a collision may turn each body off its course (`drop_idle_manifolds`).
+    gaps: Vec<f64>,
+    turn_off: Vec<f64>,
+    /// Velocities before this step's forces, for restitution.
+    start_velocities: Vec<(Vec2, f64)>,
+    /// Poses and velocities at the start of the step, to redo it with finer substeps.
+    saved_state: Vec<(Vec2, f64, Vec2, f64)>,
+    joint_constraints: Vec<JointConstraint>,
+    joint_solver: JointBlockSolver,
+    simultaneous: SimultaneousSolver,
+    soft: SoftStepSolver,
+    accelerations: Vec<(Vec2, f64)>,
+    /// Every body's centroid and angle when the step began, for continuous collision.
+    step_start: Vec<(Vec2, f64)>,
+    /// Continuous collision: the moving body's outline where its step ends and starts,
+    /// and the time-of-impact search's own.
+    mover_at_end: WorldPolygon,
+    mover_at_start: WorldPolygon,
+    toi_scratch: WorldPolygon,
+    /// Continuous collision: static bodies' slots, outlines and bounds; the bodies
+    /// stopped and their times of impact; joint islands and each island's earliest impact.
+    obstacles: Vec<(u32, WorldPolygon, Aabb)>,
+    impacts: Vec<(u32, f64)>,
+    impact_union: UnionFind,
+    island_impact: Vec<f64>,
+    /// `auto`: the islands' links and row counts, which bodies are in big islands, the
+    /// bodies held in the current pass, the exact pass's contacts while the soft pass
+    /// runs, and both passes' island reports.
+    auto_links: Vec<(u32, u32, usize)>,
+    island_rows: Vec<usize>,
+    island_needs: Vec<IslandNeeds>,
+    /// Per body: whether it is kept on the soft step this step (`World::soft_until`).
+    prefer_soft: Vec<bool>,
+    in_soft_island: Vec<bool>,
+    last_marking: LastMarking,
+    #[cfg(test)]
+    marks_kept: usize,
+    held: Vec<(u32, (Vec2, f64))>,
+    exact_contacts: Vec<Contact>,
+    exact_manifolds: Vec<Manifold>,
+    auto_reports: Vec<IslandReport>,
+    /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
+    /// the next contact detection at the same step length: set by `auto` only.
+    candidates_current: bool,
+}
+
+impl World {
+    pub fn new(gravity: Vec2) -> Self {
+        Self {
+            gravity,
+            ..Self::default()
+        }
+    }
+
+    pub fn add_body(&mut self, def: BodyDef) -> Result<BodyHandle, BodyError> {
+        let body = Body::new(def)?;
+        self.bodies.push(Some(body));
+        Ok(BodyHandle((self.bodies.len() - 1) as u32))
+    }
+
+    /// Removes a body; its handle then finds nothing. Returns the body if it existed.
+    pub fn remove_body(&mut self, handle: BodyHandle) -> Option<Body> {
+        self.bodies.get_mut(handle.index())?.take()
+    }
+
+    pub fn body(&self, handle: BodyHandle) -> Option<&Body> {
+        self.bodies.get(handle.index())?.as_ref()
+    }
+
+    pub fn body_mut(&mut self, handle: BodyHandle) -> Option<&mut Body> {
+        self.bodies.get_mut(handle.index())?.as_mut()
+    }
+
+    /// The median bounding radius of the bodies that can move (none: `None`): the size of
+    /// a typical body, for `StepSettings::length_scale` in a scene not in metres.
+    pub fn median_body_radius(&self) -> Option<f64> {
+        let mut sizes: Vec<f64> = self
+            .bodies()
+            .filter(|(_, b)| !b.is_static())
+            .map(|(_, b)| b.bounding_radius())
+            .collect();
+        sizes.sort_by(f64::total_cmp);
+        sizes.get(sizes.len() / 2).copied()
+    }
+
+    /// Live bodies in handle order.
+    pub fn bodies(&self) -> impl Iterator<Item = (BodyHandle, &Body)> {
+        self.bodies
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| Some((BodyHandle(i as u32), b.as_ref()?)))
+    }
+
+    /// Pins two bodies (or one to the world) at `def.anchor`; both body-space anchors are
+    /// derived from that point now.
+    pub fn add_joint(&mut self, def: JointDef) -> Result<JointHandle, JointError> {
+        if !(def.anchor.x.is_finite() && def.anchor.y.is_finite()) {
+            return Err(JointError::NonFiniteAnchor);
+        }
+        let far = def.anchor.x.abs().max(def.anchor.y.abs());
+        if far > crate::limits::COORDINATE {
+            return Err(JointError::AnchorBeyond(far, crate::limits::COORDINATE));
+        }
+        if Some(def.body_a) == def.body_b {
+            return Err(JointError::SameBody);
+        }
+        if let Some(m) = &def.motor {
+            m.validate().map_err(JointError::BadMotor)?;
+        }
+        let a = self.body(def.body_a).ok_or(JointError::MissingBody)?;
+        let local_anchor_a = a.to_local(def.anchor);
+        let local_anchor_b = match def.body_b {
+            Some(h) => self
+                .body(h)
+                .ok_or(JointError::MissingBody)?
+                .to_local(def.anchor),
+            None => def.anchor,
+        };
+        self.joints.push(Some(Joint {
+            body_a: def.body_a,
+            body_b: def.body_b,
+            local_anchor_a,
+            local_anchor_b,
+            collide_connected: def.collide_connected,
+            motor: def.motor,
+        }));
+        self.collision_filter_stale = true;
+        Ok(JointHandle((self.joints.len() - 1) as u32))
+    }
+
+    pub fn remove_joint(&mut self, handle: JointHandle) -> Option<Joint> {
+        let removed = self.joints.get_mut(handle.index())?.take();
+        self.collision_filter_stale = true;
+        removed
+    }
+
+    pub fn joint(&self, handle: JointHandle) -> Option<&Joint> {
+        self.joints.get(handle.index())?.as_ref()
+    }
+
+    /// A joint to change; its bodies and `collide_connected` are read again at the next
+    /// step.
+    pub fn joint_mut(&mut self, handle: JointHandle) -> Option<&mut Joint> {
+        let joint = self.joints.get_mut(handle.index())?.as_mut()?;
+        self.collision_filter_stale = true;
+        Some(joint)
+    }
+
+    /// A joint's motor to change (switching it on and off, say) without the joint's
+    /// collision filter being rebuilt, as `joint_mut` has it.
+    pub fn joint_motor_mut(&mut self, handle: JointHandle) -> Option<&mut JointMotor> {
+        self.joints
+            .get_mut(handle.index())?
+            .as_mut()?
+            .motor
+            .as_mut()
+    }
+
+    /// Live joints in handle order.
+    pub fn joints(&self) -> impl Iterator<Item = (JointHandle, &Joint)> {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter_map(|(i, j)| Some((JointHandle(i as u32), j.as_ref()?)))
+    }
+
+    /// World positions of a joint's two anchors (equal while the joint holds).
+    pub fn joint_anchors(&self, handle: JointHandle) -> Option<(Vec2, Vec2)> {
+        let j = self.joint(handle)?;
+        let a = self.body(j.body_a)?.to_world(j.local_anchor_a);
+        let b = match j.body_b {
+            Some(h) => self.body(h)?.to_world(j.local_anchor_b),
+            None => j.local_anchor_b,
+        };
+        Some((a, b))
+    }
+
+    /// Distance between a joint's anchors.
+    pub fn joint_gap(&self, handle: JointHandle) -> Option<f64> {
+        self.joint_anchors(handle).map(|(a, b)| (a - b).norm())
+    }
+
+    /// The widest gap of any joint.
+    pub fn max_joint_gap(&self) -> f64 {
+        self.joints()
+            .filter_map(|(h, _)| self.joint_gap(h))
+            .fold(0.0, f64::max)
+    }
+
+    /// Adds a thesis body motor (SPEC §4.4) driving `body`. Returns its index.
+    pub fn add_body_motor(
+        &mut self,
+        body: BodyHandle,
+        motor: BodyMotor,
+    ) -> Result<usize, MotorError> {
+        motor.validate()?;
+        self.body_motors.push((body, motor));
+        Ok(self.body_motors.len() - 1)
+    }
+
+    pub fn body_motors(&self) -> &[(BodyHandle, BodyMotor)] {
+        &self.body_motors
+    }
+
+    /// Bodies `a` and `b` never collide with each other (e.g. a mechanism's parts that
+    /// would lie in different planes, like a linkage and its frame).
+    pub fn ignore_collisions(&mut self, a: BodyHandle, b: BodyHandle) {
+        if a != b {
+            self.ignored_pairs.push((a.0.min(b.0), a.0.max(b.0)));
+            self.collision_filter_stale = true;
+        }
+    }
+
+    pub fn step_count(&self) -> u64 {
+        self.step_count
+    }
+
+    /// The manifolds found by the last step.
+    pub fn manifolds(&self) -> &[Manifold] {
+        &self.manifolds
+    }
+
+    /// The contact points of the last step with the impulses the solver gave them.
+    pub fn contacts(&self) -> &[Contact] {
+        &self.contacts
+    }
+
+    pub fn kinetic_energy(&self) -> f64 {
+        self.bodies().map(|(_, b)| b.kinetic_energy()).sum()
+    }
+
+    /// Potential energy in the uniform gravity field, zero at the world origin.
+    pub fn potential_energy(&self) -> f64 {
+        self.bodies()
+            .map(|(_, b)| -b.mass() * self.gravity.dot(&b.position))
+            .sum()
+    }
+
+    pub fn linear_momentum(&self) -> Vec2 {
+        self.bodies().map(|(_, b)| b.velocity * b.mass()).sum()
+    }
+
+    pub fn angular_momentum(&self) -> f64 {
+        self.bodies().map(|(_, b)| b.angular_momentum()).sum()
+    }
+
+    /// Advances the world by `dt`: SPEC §3.4's stages, in order.
+    ///
+    /// With `settings.sleeping`, an island (bodies linked by contacts and joints) whose
+    /// bodies have all been slower than `sleep_speed` for `SLEEP_AFTER` seconds, with no
+    /// motor running, goes to sleep: it is skipped until an awake body comes within reach
+    /// of one of its bodies, a motor on it switches on, or `wake_body` is called.
+    ///
+    /// With `settings.continuous`, a body that moved more than half its inner radius (or,
+    /// without joints, the contact margin) this step and ended up through a static body
+    /// it collides with, or deeper than twice the slop in it, is put back along its path
+    /// to where it first came within the slop of it (its time of impact) or, if it
+    /// started in contact, to where it was twice the slop deep. It keeps its velocity for
+    /// the next step's contacts to answer. A jointed body takes its joint island with it,
+    /// each body to the same fraction of its path. Speculative contacts stop most fast
+    /// bodies already; this catches what they miss (a spinning body, the soft step's
+    /// contacts found only at the step's start, a link the thesis's joint pass drags on).
+    ///
+    /// A step refused by `try_step` does nothing; one that leaves a body's state beyond
+    /// the limits is reported there, and here ignored.
+    ///
+    /// A box dropped onto a static floor comes to rest on it:
+    ///
+    /// ```
+    /// use pe::{BodyDef, ConvexPolygon, Vec2, World};
+    ///
+    /// let mut world = World::new(Vec2::new(0.0, 9.81)); // y points down
+    /// let floor = ConvexPolygon::rectangle(10.0, 1.0).unwrap(); // its top at y = 0
+    /// world.add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0)).unwrap();
+    /// let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    /// let dropped = BodyDef::new(square, 1.0).at(Vec2::new(0.0, -2.0), 0.0);
+    /// let square = world.add_body(dropped).unwrap();
+    /// for _ in 0..120 {
+    ///     world.step(1.0 / 60.0);
+    /// }
+    /// let body = world.body(square).unwrap();
+    /// assert!((body.position.y + 0.5).abs() < 0.01, "on the floor: {:?}", body.position);
+    /// assert!(body.velocity.norm() < 1e-3, "at rest: {:?}", body.velocity);
+    /// assert_eq!(world.contacts().len(), 2, "touching along its bottom edge");
+    /// ```
+    pub fn step(&mut self, dt: f64) {
+        let _refused = self.try_step(dt);
+    }
+
+    /// `step`, refusing a time step that is not finite and positive, gravity or a world
+    /// friction (≥ 0) that is not finite or beyond its limit in `crate::limits`, or gravity
+    /// that would carry a body more than `FALL_PER_STEP` length scales in the step, with
+    /// the reason; and reporting a step that left a moving body's state non-finite or
+    /// beyond the limits (then the state is not to be trusted). (Bodies, joints and motors
+    /// are checked when they are added.)
+    ///
+    /// ```
+    /// use pe::{StepError, Vec2, World};
+    ///
+    /// let mut world = World::new(Vec2::new(0.0, 9.81));
+    /// assert_eq!(world.try_step(0.0), Err(StepError::BadTimeStep(0.0)));
+    /// assert_eq!(world.step_count(), 0, "a refused step does nothing");
+    /// assert_eq!(world.try_step(1.0 / 60.0), Ok(()));
+    /// assert_eq!(world.step_count(), 1);
+    /// ```
+    pub fn try_step(&mut self, dt: f64) -> Result<(), StepError> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(StepError::BadTimeStep(dt));
+        }
+        let g = crate::limits::GRAVITY;
+        if !(self.gravity.x.abs() <= g && self.gravity.y.abs() <= g) {
+            return Err(StepError::BadGravity(self.gravity.x, self.gravity.y));
+        }
+        if !(0.0..=crate::limits::FRICTION).contains(&self.friction) {
+            return Err(StepError::BadFriction(self.friction));
+        }
+        let fall = self.gravity.norm() * dt * dt;
+        let limit = FALL_PER_STEP * self.settings.length_scale;
+        if fall > limit {
+            return Err(StepError::FallsTooFar { fall, limit });
+        }
+        let started = stage_clock::mark();
+        self.advance(dt);
+        stage_clock::record(Stage::Step, started);
+        self.check_state()
+    }
+
+    /// Every moving body's state finite and within `crate::limits`.
+    fn check_state(&self) -> Result<(), StepError> {
+        use crate::limits::{COORDINATE, SPEED, SPIN};
+        for (i, body) in self.bodies.iter().enumerate() {
+            let Some(b) = body.as_ref().filter(|b| !b.is_fixed()) else {
+                continue;
+            };
+            let numbers = [
+                ("x", b.position.x, COORDINATE),
+                ("y", b.position.y, COORDINATE),
+                ("speed", b.velocity.norm(), SPEED),
+                ("spin", b.angular_velocity, SPIN),
+            ];
+            if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
+                return Err(StepError::StateBeyond {
+                    body: i as u32,
+                    what,
+                    value,
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn advance(&mut self, dt: f64) {
+        self.refresh_collision_filter();
+        if self.settings.sleeping {
+            self.wake_where_needed(dt);
+        }
+        if self.settings.continuous {
+            let start = &mut self.scratch.step_start;
+            start.clear();
+            start.extend(self.bodies.iter().map(|b| {
+                b.as_ref()
+                    .map_or((Vec2::zeros(), 0.0), |b| (b.position, b.angle))
+            }));
+        }
+        self.apply_motor_torques(dt);
+        match self.settings.contact_solver {
+            ContactSolver::Soft => self.step_soft(dt),
+            ContactSolver::Auto => self.step_auto(dt),
+            _ => self.step_impulses(dt),
+        }
+        self.clear_forces();
+        self.step_count += 1;
+        if self.settings.continuous {
+            let started = stage_clock::mark();
+            self.stop_at_impact();
+            stage_clock::record(Stage::Continuous, started);
+        }
+        if self.settings.sleeping {
+            self.sleep_where_still(dt);
+        } else if !self.sleep_labels.is_empty() {
+            // Sleeping was switched off: wake everyone, once.
+            self.bodies.iter_mut().flatten().for_each(Body::wake);
+            self.sleep_labels.clear();
+        }
+    }
+
+    fn step_impulses(&mut self, dt: f64) {
+        self.repair_broken_joints(dt);
+        let mut substeps = self.substeps_for(dt);
+        // A joint still broken is being repaired on purpose over several steps; only
+        // joints that should have closed ask for finer substeps.
+        let repairing = self.max_joint_gap() > self.settings.joint_iterations(dt).broken_gap;
+        loop {
+            self.save_state();
+            let h = dt / substeps as f64;
+            self.for_each_motor(|m| m.step_impulse = 0.0);
+            for _ in 0..substeps {
+                self.correct_joint_velocities(h);
+                self.integrate_velocities(h);
+                self.detect_contacts(h, Pipeline::Impulses);
+                self.push_apart();
+                self.solve_constraints(h);
+                self.place_bounces_at_impact(h);
+                self.integrate_positions(h);
+                self.for_each_motor(|m| {
+                    if m.enabled {
+                        m.step_impulse += m.last_impulse;
+                    }
+                });
+            }
+            // A whip can spin links up within the step; if they now turn too far per
+            // substep, this step's joint prediction was not trustworthy: redo it finer.
+            let mut needed = self.substeps_for(dt);
+            if !repairing && self.max_joint_gap() > 1e-3 * self.settings.length_scale {
+                needed = needed.max(2 * substeps);
+            }
+            if needed <= substeps || substeps >= MAX_SUBSTEPS {
+                break;
+            }
+            self.restore_state();
+            substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
+        }
+    }
+
+    /// The soft step has its own stage list: forces, contacts found once, then substeps
+    /// that integrate and solve together (see `solver::soft`).
+    fn step_soft(&mut self, dt: f64) {
+        self.scratch.start_velocities.clear(); // forces act inside the substeps
+        self.detect_contacts(dt, Pipeline::Soft);
+        // The soft step pulls every pin closed its own way: no repair targets.
+        self.gather_solver_bodies_with(GapTargets::None);
+        let s = &mut self.scratch;
+        s.accelerations.clear();
+        s.accelerations.extend(self.bodies.iter().map(|b| match b {
+            Some(b) if !b.is_fixed() => (
+                self.gravity + b.force * b.inv_mass,
+                b.torque * b.inv_inertia,
+            ),
+            _ => (Vec2::zeros(), 0.0),
+        }));
+        s.accelerations.push((Vec2::zeros(), 0.0));
+        s.soft.step(
+            &SoftSettings {
+                substeps: self.settings.soft_substeps.max(1),
+                alternating_sweeps: self.settings.soft_alternating_sweeps,
+                ..SoftSettings::for_length_scale(self.settings.length_scale)
+            },
+            &mut s.solver_bodies,
+            &s.accelerations,
+            &mut self.contacts,
+            &mut s.joint_constraints,
+            dt,
+            restitution_threshold(self.gravity, dt),
+        );
+        self.scatter_solver_bodies();
+    }
+
+    /// How each island was solved in the last step: by which method (see
+    /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
+    /// `thesis` the last substep's islands; under `soft` the step's; under `auto` both passes'.
+    pub fn island_reports(&self) -> &[IslandReport] {
+        match self.settings.contact_solver {
+            ContactSolver::Soft => &self.scratch.soft.reports,
+            ContactSolver::Auto => &self.scratch.auto_reports,
+            _ => &self.scratch.simultaneous.reports,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shape::ConvexPolygon;
+
+    /// A manifold that goes into the kept plan's lanes is not written to the soft step's
+    /// points; when the plan changes after all, or something bounces, they are built
+    /// again. A pile stepped so must move exactly as one whose every point is written,
+    /// through a box landing on it (the plan changes) and one bouncing on its top box
+    /// (restitution is the smaller of the two bodies': only the top box has any).
+    #[test]
+    fn points_left_unwritten_change_no_step() {
+        let (h, rows) = (1.0 / 60.0, 8);
+        let pile = |write_every_point| {
+            let mut world = World::new(Vec2::new(0.0, 10.0));
+            world.settings.contact_solver = ContactSolver::Soft;
+            world.friction = 0.6;
+            let floor = ConvexPolygon::rectangle(40.0, 1.0).unwrap();
+            world
+                .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+                .unwrap();
+            let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+            for row in 0..rows {
+                for i in 0..rows - row {
+                    let x = i as f64 - 0.5 * (rows - 1 - row) as f64;
+                    let centre = Vec2::new(x, -0.5 - row as f64);
+                    let def = BodyDef::new(unit.clone(), 1.0).at(centre, 0.0);
+                    let top = row == rows - 1;
+                    world
+                        .add_body(if top { def.restitution(0.5) } else { def })
+                        .unwrap();
+                }
+            }
+            world.scratch.soft.write_every_point = write_every_point;
+            world
+        };
+        let (mut skipping, mut writing) = (pile(false), pile(true));
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for step in 0..300 {
+            let dropped = match step {
+                90 => Some((BodyDef::new(unit.clone(), 1.0), -3.0)),
+                180 => Some((BodyDef::new(unit.clone(), 1.0).restitution(0.5), 0.1)),
+                _ => None,
+            };
+            if let Some((def, x)) = dropped {
+                let def = def.at(Vec2::new(x, -(rows as f64) - 3.0), 0.1);
+                skipping.add_body(def.clone()).unwrap();
+                writing.add_body(def).unwrap();
+            }
+            skipping.step(h);
+            writing.step(h);
+            let bits = |w: &World| -> Vec<u64> {
+                w.bodies()
+                    .flat_map(|(_, b)| b.state())
+                    .map(f64::to_bits)
+                    .collect()
+            };
+            assert_eq!(bits(&skipping), bits(&writing), "step {step}");
+        }
+        let (skipped, rebuilt) = skipping.scratch.soft.steps_skipping;
+        assert!(skipped > 200, "{skipped} steps left points unwritten");
+        // The landing's step or two, and every step from the bouncing box's first
+        // contact on.
+        assert!(
+            (50..150).contains(&rebuilt),
+            "{rebuilt} built their points again"
+        );
+        assert_eq!(writing.scratch.soft.steps_skipping, (0, 0));
+    }
+
+    /// Every pair of bodies, not both fixed, whose bounds overlap now: what the broad
+    /// phase must find, by comparing every pair.
+    pub(super) fn overlapping_pairs(world: &World) -> Vec<(u32, u32)> {
+        let boxes = &world.scratch.boxes;
+        let n = boxes.len();
+        let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
+        (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .filter(|&(i, j)| !(fixed(i) && fixed(j)))
+            .filter(|&(i, j)| match (&boxes[i], &boxes[j]) {
+                (Some(a), Some(b)) => a.overlaps(b),
+                _ => false,
+            })
+            .map(|(i, j)| (i as u32, j as u32))
+            .collect()
+    }
+
+    /// A 10-row pyramid of unit boxes (55, a soft island) on a floor, under `auto`, g = 10.
+    pub(super) fn pyramid_under_auto() -> World {
+        let mut world = World::new(Vec2::new(0.0, 10.0));
+        world.settings.contact_solver = ContactSolver::Auto;
+        let floor = ConvexPolygon::rectangle(100.0, 1.0).unwrap();
+        world
+            .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for row in 0..10 {
+            for i in 0..10 - row {
+                let at = Vec2::new(i as f64 - 0.5 * (9 - row) as f64, -0.5 - row as f64);
+                world
+                    .add_body(BodyDef::new(unit.clone(), 1.0).at(at, 0.0))
+                    .unwrap();
+            }
+        }
+        world
+    }
+}

@@ -1,0 +1,182 @@
+//! Sleeping: islands at rest long enough fall asleep, and wake when an awake body can
+//! reach them or a motor on them switches on.
+
+use super::World;
+use crate::body::{Body, BodyHandle};
+use crate::collide::Aabb;
+use crate::math::Vec2;
+
+/// Seconds an island must stay still before it sleeps.
+const SLEEP_AFTER: f64 = 0.5;
+
+impl World {
+    /// Wakes `handle` and everything asleep in its island.
+    pub fn wake_body(&mut self, handle: BodyHandle) {
+        let Some(label) = self.sleep_labels.get(handle.index()).copied() else {
+            return;
+        };
+        if self.body(handle).is_some_and(|b| b.asleep) {
+            self.wake_island(label);
+        }
+    }
+
+    fn wake_island(&mut self, label: u32) {
+        for (body, &l) in self.bodies.iter_mut().zip(&self.sleep_labels) {
+            if let Some(b) = body
+                && b.asleep
+                && l == label
+            {
+                b.wake();
+            }
+        }
+    }
+
+    /// Wakes sleeping islands that an awake body can reach this step, and those with a
+    /// motor switching on. Candidates come from the broad phase over the bodies' bounding
+    /// circles (each awake one grown by its reach), so the cost follows the bodies near
+    /// each other, not awake × asleep.
+    pub(super) fn wake_where_needed(&mut self, dt: f64) {
+        let margin = self.settings.contact_margin();
+        let mut wake = std::mem::take(&mut self.scratch.wake_labels);
+        wake.clear();
+        let some_asleep = self.bodies.iter().flatten().any(|b| b.asleep);
+        let some_awake = self.bodies.iter().flatten().any(|b| !b.is_fixed());
+        if some_asleep && some_awake {
+            let reach = |b: &Body| {
+                (b.velocity.norm()
+                    + b.angular_velocity.abs() * b.bounding_radius()
+                    + self.gravity.norm() * dt)
+                    * dt
+            };
+            let s = &mut self.scratch;
+            s.boxes.clear();
+            s.reach.clear();
+            for body in &self.bodies {
+                let r = body
+                    .as_ref()
+                    .map_or(0.0, |b| if b.asleep { 0.0 } else { reach(b) });
+                s.reach.push(r);
+                s.boxes
+                    .push(body.as_ref().filter(|b| !b.is_static()).map(|b| {
+                        let half = b.bounding_radius() + r + 0.5 * margin;
+                        Aabb {
+                            min: b.position - Vec2::new(half, half),
+                            max: b.position + Vec2::new(half, half),
+                        }
+                    }));
+            }
+            let bodies = &self.bodies;
+            let asleep = |i: usize| bodies[i].as_ref().is_some_and(|b| b.asleep);
+            s.wake_broad_phase
+                .pairs(&s.boxes, |i, j| asleep(i) != asleep(j), &mut s.pairs);
+            for &(i, j) in &s.pairs {
+                let (sleeper, awake) = if asleep(i as usize) { (i, j) } else { (j, i) };
+                let (b, a) = (
+                    bodies[sleeper as usize].as_ref().expect("boxed"),
+                    bodies[awake as usize].as_ref().expect("boxed"),
+                );
+                let apart =
+                    (b.position - a.position).norm() - b.bounding_radius() - a.bounding_radius();
+                if apart <= margin + s.reach[awake as usize] {
+                    wake.push(self.sleep_labels[sleeper as usize]);
+                }
+            }
+        }
+        let step = self.step_count;
+        for (h, m) in &self.body_motors {
+            if m.is_on(step) && self.body(*h).is_some_and(|b| b.asleep) {
+                wake.push(self.sleep_labels[h.index()]);
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if j.motor.is_some_and(|m| m.enabled) {
+                for h in [Some(j.body_a), j.body_b].into_iter().flatten() {
+                    if self.body(h).is_some_and(|b| b.asleep) {
+                        wake.push(self.sleep_labels[h.index()]);
+                    }
+                }
+            }
+        }
+        wake.sort_unstable();
+        wake.dedup();
+        for &label in &wake {
+            self.wake_island(label);
+        }
+        self.scratch.wake_labels = wake;
+    }
+
+    /// Times how long each awake body has been still, and puts to sleep the islands whose
+    /// bodies have all been still long enough.
+    pub(super) fn sleep_where_still(&mut self, dt: f64) {
+        let tolerance = self.settings.sleep_speed();
+        for b in self.bodies.iter_mut().flatten() {
+            if b.is_fixed() {
+                continue;
+            }
+            let speed = b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius();
+            b.still_time = if speed < tolerance {
+                b.still_time + dt
+            } else {
+                0.0
+            };
+        }
+        let n = self.bodies.len();
+        let moving = |bodies: &[Option<Body>], i: u32| {
+            bodies[i as usize].as_ref().is_some_and(|b| !b.is_fixed())
+        };
+        let uf = &mut self.scratch.island_union;
+        uf.reset(n);
+        for c in &self.contacts {
+            if moving(&self.bodies, c.body_a) && moving(&self.bodies, c.body_b) {
+                uf.union(c.body_a, c.body_b);
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if let Some(b) = j.body_b
+                && moving(&self.bodies, j.body_a.0)
+                && moving(&self.bodies, b.0)
+            {
+                uf.union(j.body_a.0, b.0);
+            }
+        }
+        // An island may sleep when its stillest-to-be body has waited long enough and no
+        // motor in it runs.
+        let mut ready = std::mem::take(&mut self.scratch.island_ready);
+        ready.clear();
+        ready.resize(n, true);
+        for i in 0..n as u32 {
+            if let Some(b) = self.bodies[i as usize].as_ref()
+                && !b.is_fixed()
+                && b.still_time < SLEEP_AFTER
+            {
+                ready[uf.find(i) as usize] = false;
+            }
+        }
+        let step = self.step_count;
+        for (h, m) in &self.body_motors {
+            if m.is_on(step) {
+                ready[uf.find(h.0) as usize] = false;
+            }
+        }
+        for j in self.joints.iter().flatten() {
+            if j.motor.is_some_and(|m| m.enabled) {
+                ready[uf.find(j.body_a.0) as usize] = false;
+                if let Some(b) = j.body_b {
+                    ready[uf.find(b.0) as usize] = false;
+                }
+            }
+        }
+        self.sleep_labels.resize(n, u32::MAX);
+        for i in 0..n as u32 {
+            let root = uf.find(i);
+            if let Some(b) = self.bodies[i as usize].as_mut()
+                && !b.is_fixed()
+                && ready[root as usize]
+            {
+                b.fall_asleep();
+                self.sleep_labels[i as usize] = root;
+            }
+        }
+        self.scratch.island_ready = ready;
+    }
+}

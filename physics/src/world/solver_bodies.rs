@@ -1,0 +1,77 @@
+//! The bodies and joints copied into the solvers' arrays (the static world last), and
+//! the solved velocities and poses copied back.
+
+use super::World;
+use crate::body::BodyHandle;
+use crate::math::Vec2;
+use crate::solver::SolverBody;
+use crate::solver::joint::{JointConstraint, velocity_gap_target};
+
+/// Whether gathering the joints works out the gap each is to close (`gap_target`): the
+/// exact and thesis solvers repair a broken joint over several steps; the soft step
+/// pulls every pin closed its own way and never reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum GapTargets {
+    ForBrokenJoints,
+    None,
+}
+
+impl World {
+    /// Copies the bodies into the solver array, the static world last, and resolves the
+    /// joints to slots in it, each with the gap it is to close this step.
+    pub(super) fn gather_solver_bodies(&mut self) {
+        self.gather_solver_bodies_with(GapTargets::ForBrokenJoints);
+    }
+
+    pub(super) fn gather_solver_bodies_with(&mut self, targets: GapTargets) {
+        let s = &mut self.scratch;
+        s.solver_bodies.clear();
+        s.solver_bodies.extend(
+            self.bodies
+                .iter()
+                .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
+        );
+        let ground = self.bodies.len() as u32;
+        s.solver_bodies.push(SolverBody::default());
+        s.joint_constraints.clear();
+        for (i, j) in self.joints.iter().enumerate() {
+            let Some(j) = j else { continue };
+            let live = |h: BodyHandle| self.bodies.get(h.index()).is_some_and(Option::is_some);
+            if !live(j.body_a) || !j.body_b.is_none_or(live) {
+                continue;
+            }
+            let mut c = JointConstraint {
+                joint: i as u32,
+                body_a: j.body_a.0,
+                body_b: j.body_b.map_or(ground, |h| h.0),
+                local_anchor_a: j.local_anchor_a,
+                local_anchor_b: j.local_anchor_b,
+                motor: j.motor,
+                gap_target: Vec2::zeros(),
+            };
+            if targets == GapTargets::ForBrokenJoints {
+                let gap_now = c.predicted_gap(&s.solver_bodies, 0.0);
+                let broken_gap = self.settings.joint_iterations(1.0).broken_gap;
+                c.gap_target = velocity_gap_target(gap_now, broken_gap);
+            }
+            s.joint_constraints.push(c);
+        }
+    }
+
+    /// Copies solved velocities (and motor impulses) back.
+    pub(super) fn scatter_solver_bodies(&mut self) {
+        for (body, solved) in self.bodies.iter_mut().zip(&self.scratch.solver_bodies) {
+            if let Some(b) = body {
+                b.velocity = solved.velocity;
+                b.angular_velocity = solved.angular_velocity;
+                b.position = solved.position;
+                b.angle = solved.angle;
+            }
+        }
+        for c in &self.scratch.joint_constraints {
+            if let Some(Some(j)) = self.joints.get_mut(c.joint as usize) {
+                j.motor = c.motor;
+            }
+        }
+    }
+}
