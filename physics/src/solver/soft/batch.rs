@@ -1860,7 +1860,8 @@ fn approach<L: Lanes>(b: &mut LaneBounce<L>, vn: L, separation: L) {
 
 #[cfg(test)]
 pub(super) mod tests {
-    use super::super::{NormalBlock, PointLevers, solve_pair, solve_point, warm_start_point};
+    use super::super::contacts::{solve_pair, solve_point, warm_start_point};
+    use super::super::{NormalBlock, PointLevers};
     use super::*;
     use crate::math::{Rot, Vec2, cross};
 

@@ -443,7 +443,7 @@ impl<L: Lanes> BatchLanes<PinPass> for PinBatch<L> {
 #[cfg(test)]
 mod tests {
     use super::super::batch::tests::{Numbers, body};
-    use super::super::{solve_joint, warm_start_pin};
+    use super::super::joints::{solve_joint, warm_start_pin};
     use super::*;
 
     /// The step's pin `k` between `a` and `b`, without a motor.

@@ -1,0 +1,412 @@
+//! The soft step's pins and motors: each pin's last impulses kept for warm starting, a
+//! small island of pins solved as one linear system, and a pin or motor solved alone.
+
+use super::contacts::BodyPair;
+use super::{SoftBody, SoftJoint, SoftStepSolver, Softness};
+use crate::math::{Rot, Vec2, clamp, cross_scalar};
+use crate::solver::envelope::EnvelopeCholesky;
+
+/// Last step's pin impulses (linear, and the motor's angular one) by joint slot.
+#[derive(Debug, Clone, Default)]
+pub(super) struct JointMemory {
+    /// `(slot, impulse, motor impulse)`, sorted by slot.
+    entries: Vec<(u32, Vec2, f64)>,
+    /// This step's, by the pin's index among the step's input joints (`Self::NONE`'s slot
+    /// where it keeps none), until `finish` makes them the entries.
+    by_input: Vec<(u32, Vec2, f64)>,
+}
+
+impl JointMemory {
+    pub(super) const NONE: (u32, Vec2, f64) = (u32::MAX, Vec2::new(0.0, 0.0), 0.0);
+
+    /// Starts a step of `inputs` joints; `recall` still reads the last step's.
+    pub(super) fn begin(&mut self, inputs: usize) {
+        self.by_input.clear();
+        self.by_input.resize(inputs, Self::NONE);
+    }
+
+    /// The pin `slot`'s impulses of the last step. The step's joints come in slot order,
+    /// so `cursor` walks the entries once; a pin found behind it is searched for.
+    pub(super) fn recall(&self, slot: u32, cursor: &mut usize) -> Option<(u32, Vec2, f64)> {
+        while self.entries.get(*cursor).is_some_and(|m| m.0 < slot) {
+            *cursor += 1;
+        }
+        match self.entries.get(*cursor) {
+            Some(&m) if m.0 == slot => Some(m),
+            _ => self
+                .entries
+                .binary_search_by_key(&slot, |m| m.0)
+                .ok()
+                .map(|k| self.entries[k]),
+        }
+    }
+
+    /// Keeps the impulses of the step's input joint `input` for the next step.
+    pub(super) fn keep(&mut self, input: u32, entry: (u32, Vec2, f64)) {
+        self.by_input[input as usize] = entry;
+    }
+
+    /// The kept impulses become the ones to recall.
+    pub(super) fn finish(&mut self) {
+        self.entries.clear();
+        let kept = self.by_input.iter().filter(|e| e.0 != Self::NONE.0);
+        self.entries.extend(kept);
+        // Input order is slot order, unless a caller gave the joints otherwise.
+        if !self.entries.is_sorted_by_key(|e| e.0) {
+            self.entries.sort_unstable_by_key(|e| e.0);
+        }
+    }
+}
+/// The system of one island of pins, its buffers reused between passes.
+#[derive(Debug, Clone, Default)]
+pub(super) struct JointBlock {
+    arms: Vec<(Vec2, Vec2)>,
+    /// K, row-major, its lower triangle filled.
+    k: Vec<f64>,
+    rhs: Vec<f64>,
+    /// This step's factor of each island's K, by island (`SoftStepSolver::joint_islands`).
+    factors: Vec<IslandFactor>,
+    /// Tests only: K factored in every pass, and how many times it was.
+    #[cfg(test)]
+    factor_every_pass: bool,
+    #[cfg(test)]
+    factored: usize,
+}
+
+/// An island's factor of K and the bits of the arms it was made from. K depends on the
+/// arms and on the bodies' masses, which a step does not change, and the arms only on the
+/// bodies' rotations: the relax pass of one substep and the biased pass of the next see
+/// the same rotations (velocities change between them, positions do not), so the second
+/// takes the first's factor, the same to the bit.
+#[derive(Debug, Clone, Default)]
+struct IslandFactor {
+    /// Empty if no factor was made this step.
+    arm_bits: Vec<[u64; 4]>,
+    factor: EnvelopeCholesky,
+}
+
+fn arm_bits(arms: &[(Vec2, Vec2)]) -> impl Iterator<Item = [u64; 4]> + '_ {
+    arms.iter()
+        .map(|(a, b)| [a.x, a.y, b.x, b.y].map(f64::to_bits))
+}
+
+pub(super) fn rotate_delta(q: Rot, r: Vec2) -> Vec2 {
+    q.apply(r)
+}
+
+impl SoftStepSolver {
+    fn apply(bodies: &mut [SoftBody], a: u32, b: u32, r_a: Vec2, r_b: Vec2, impulse: Vec2) {
+        let mut pair = BodyPair::load(bodies, a, b);
+        pair.apply(r_a, r_b, impulse);
+        pair.store(bodies);
+    }
+}
+
+/// Re-applies a pin's motor's accumulated angular impulse (zero without one).
+pub(super) fn warm_start_motor(bodies: &mut [SoftBody], j: &SoftJoint) {
+    let (a, b) = (j.a as usize, j.b as usize);
+    let ia = bodies[a].inv_inertia;
+    bodies[a].w += ia * j.motor_impulse;
+    let ib = bodies[b].inv_inertia;
+    bodies[b].w -= ib * j.motor_impulse;
+}
+
+/// Re-applies a pin's accumulated impulse (not its motor's) at the start of a substep,
+/// at its anchors where they are now: at the step's first arms, a tiny-inertia body far
+/// from its pin would be spun by the stale lever.
+pub(super) fn warm_start_pin(bodies: &mut [SoftBody], j: &SoftJoint) {
+    let ra = rotate_delta(bodies[j.a as usize].dq, j.r_a);
+    let rb = rotate_delta(bodies[j.b as usize].dq, j.r_b);
+    SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, j.impulse);
+}
+
+/// A joint motor: the relative spin driven towards its target, within ±max torque·h.
+pub(super) fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
+    if let Some((target, max_torque)) = j.motor {
+        let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
+        let k = a.inv_inertia + b.inv_inertia;
+        if k > 0.0 {
+            let limit = max_torque * h;
+            let total = clamp(j.motor_impulse - (a.w - b.w - target) / k, -limit, limit);
+            let delta = total - j.motor_impulse;
+            j.motor_impulse = total;
+            bodies[j.a as usize].w += a.inv_inertia * delta;
+            bodies[j.b as usize].w -= b.inv_inertia * delta;
+        }
+    }
+}
+
+/// A pin's current arms, its anchors' relative velocity plus the soft bias towards a
+/// closed gap, and the softness scales for this pass.
+fn pin_target(
+    bodies: &[SoftBody],
+    j: &SoftJoint,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) -> ((Vec2, Vec2), Vec2, f64, f64) {
+    let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
+    let ra = rotate_delta(a.dq, j.r_a);
+    let rb = rotate_delta(b.dq, j.r_b);
+    let dv = (a.v + cross_scalar(a.w, ra)) - (b.v + cross_scalar(b.w, rb));
+    if !use_bias {
+        return ((ra, rb), dv, 1.0, 0.0);
+    }
+    let gap = (a.dp + ra - j.r_a) - (b.dp + rb - j.r_b) + j.base_gap;
+    let bias = gap * soft.bias_rate;
+    let speed = (bias.x * bias.x + bias.y * bias.y).sqrt();
+    let bias = if speed > max_push {
+        bias * (max_push / speed)
+    } else {
+        bias
+    };
+    ((ra, rb), dv + bias, soft.mass_scale, soft.impulse_scale)
+}
+
+impl JointBlock {
+    /// Starts a step of `islands` islands of pins: no factor made yet.
+    pub(super) fn begin_step(&mut self, islands: usize) {
+        self.factors.resize_with(islands, IslandFactor::default);
+        for cached in &mut self.factors {
+            cached.arm_bits.clear();
+        }
+    }
+
+    /// Solves the pins of island `index` (`island`) together: K ψ = −(Δv + bias) over all
+    /// of them, then each impulse softened as a lone pin's would be. False if K is not
+    /// positive definite (redundant pins), leaving the bodies untouched.
+    pub(super) fn solve(
+        &mut self,
+        bodies: &mut [SoftBody],
+        (index, island): (usize, &mut [SoftJoint]),
+        soft: &Softness,
+        max_push: f64,
+        use_bias: bool,
+    ) -> bool {
+        let n = 2 * island.len();
+        self.arms.clear();
+        self.rhs.clear();
+        self.rhs.resize(n, 0.0);
+        let (mut mass_scale, mut impulse_scale) = (1.0, 0.0);
+        for (p, j) in island.iter().enumerate() {
+            let (arms, target, ms, is) = pin_target(bodies, j, soft, max_push, use_bias);
+            self.arms.push(arms);
+            (mass_scale, impulse_scale) = (ms, is);
+            self.rhs[2 * p] = -target.x;
+            self.rhs[2 * p + 1] = -target.y;
+        }
+        let cached = &self.factors[index];
+        let same_arms = cached.arm_bits.iter().copied().eq(arm_bits(&self.arms));
+        #[cfg(test)]
+        let same_arms = same_arms && !self.factor_every_pass;
+        if !same_arms {
+            #[cfg(test)]
+            {
+                self.factored += 1;
+            }
+            let cached = &mut self.factors[index];
+            let factored =
+                Self::factor(bodies, island, &self.arms, &mut self.k, &mut cached.factor);
+            cached.arm_bits.clear();
+            if !factored {
+                return false;
+            }
+            cached.arm_bits.extend(arm_bits(&self.arms));
+        }
+        self.factors[index].factor.solve(&mut self.rhs);
+        let psi = &self.rhs;
+        for (p, j) in island.iter_mut().enumerate() {
+            let impulse =
+                Vec2::new(psi[2 * p], psi[2 * p + 1]) * mass_scale - j.impulse * impulse_scale;
+            j.impulse += impulse;
+            let (ra, rb) = self.arms[p];
+            SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);
+        }
+        true
+    }
+
+    /// Builds K for `island`'s pins at `arms` (into `k`) and factors it into `factor`:
+    /// false if it is not positive definite.
+    fn factor(
+        bodies: &[SoftBody],
+        island: &[SoftJoint],
+        arms: &[(Vec2, Vec2)],
+        k: &mut Vec<f64>,
+        factor: &mut EnvelopeCholesky,
+    ) -> bool {
+        let m = island.len();
+        let n = 2 * m;
+        k.clear();
+        k.resize(n * n, 0.0);
+        for p in 0..m {
+            for q in p..m {
+                // Pins with no body in common do not couple: their block stays zero (a
+                // chain's K is block-tridiagonal, which the factorization exploits).
+                let (jp, jq) = (&island[p], &island[q]);
+                if jp.a != jq.a && jp.a != jq.b && jp.b != jq.a && jp.b != jq.b {
+                    continue;
+                }
+                let block = coupling(bodies, jp, arms[p], jq, arms[q]);
+                // The lower triangle: row 2q + c, column 2p + r (a pin's own block: row r,
+                // column c).
+                for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+                    let (row, column) = if p == q { (r, c) } else { (c, r) };
+                    k[(2 * q + row) * n + 2 * p + column] = block[r][c];
+                }
+            }
+        }
+        // Redundant pins (a body pinned to the world twice, a closed loop) make K singular:
+        // its factor then has a pivot at round-off level and the impulses blow up. Only
+        // then is K regularised (by 1e-9 of its largest diagonal, which keeps the impulses
+        // bounded): a heavy chain's K is ill-conditioned but regular, and even that much
+        // regularisation doubled its gap.
+        let largest = (0..n).map(|i| k[i * n + i]).fold(0.0, f64::max);
+        if !factor.factor(k, n, 1e-12 * largest) {
+            for i in 0..n {
+                k[i * n + i] += 1e-9 * largest;
+            }
+            return factor.factor(k, n, 0.0);
+        }
+        true
+    }
+}
+
+/// The velocity change at pin `p`'s anchors per unit impulse at pin `q`'s: one 2×2 block
+/// of J M⁻¹ Jᵀ, summed over the bodies they share (+ on A, − on B).
+fn coupling(
+    bodies: &[SoftBody],
+    p: &SoftJoint,
+    (pa, pb): (Vec2, Vec2),
+    q: &SoftJoint,
+    (qa, qb): (Vec2, Vec2),
+) -> [[f64; 2]; 2] {
+    let mut k = [[0.0; 2]; 2];
+    for (bp, sp, rp) in [(p.a, 1.0, pa), (p.b, -1.0, pb)] {
+        for (bq, sq, rq) in [(q.a, 1.0, qa), (q.b, -1.0, qb)] {
+            let body = &bodies[bp as usize];
+            if bp != bq || !body.moves() {
+                continue;
+            }
+            let (m, i) = (body.inv_mass, body.inv_inertia);
+            let s = sp * sq;
+            // Δv at rp = m·P + i·(rq × P)·perp(rp), P a unit impulse along x, then y.
+            k[0][0] += s * (m + i * rp.y * rq.y);
+            k[0][1] += s * (-i * rp.y * rq.x);
+            k[1][0] += s * (-i * rp.x * rq.y);
+            k[1][1] += s * (m + i * rp.x * rq.x);
+        }
+    }
+    k
+}
+
+/// One pin alone (islands too big for the block solve).
+pub(super) fn solve_joint(
+    bodies: &mut [SoftBody],
+    j: &mut SoftJoint,
+    soft: &Softness,
+    max_push: f64,
+    use_bias: bool,
+) {
+    let ((ra, rb), target, mass_scale, impulse_scale) =
+        pin_target(bodies, j, soft, max_push, use_bias);
+    let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
+    let m = a.inv_mass + b.inv_mass;
+    let (ia, ib) = (a.inv_inertia, b.inv_inertia);
+    let k11 = m + ia * ra.y * ra.y + ib * rb.y * rb.y;
+    let k12 = -ia * ra.x * ra.y - ib * rb.x * rb.y;
+    let k22 = m + ia * ra.x * ra.x + ib * rb.x * rb.x;
+    let det = k11 * k22 - k12 * k12;
+    if det <= 0.0 {
+        return;
+    }
+    let rhs = target;
+    let solved = Vec2::new(
+        (k22 * rhs.x - k12 * rhs.y) / det,
+        (k11 * rhs.y - k12 * rhs.x) / det,
+    );
+    let impulse = -solved * mass_scale - j.impulse * impulse_scale;
+    j.impulse += impulse;
+    SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, impulse);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::SoftSettings;
+    use super::super::tests::state_bits;
+    use super::*;
+    use crate::solver::SolverBody;
+    use crate::solver::joint::JointConstraint;
+
+    /// A chain of `links` rods of 1 m along +x, pinned end to end and the first to a
+    /// fixed body at the origin.
+    fn rods(links: usize) -> (Vec<SolverBody>, Vec<JointConstraint>) {
+        let anchor = links as u32;
+        let mut bodies: Vec<SolverBody> = (0..links)
+            .map(|i| SolverBody {
+                position: Vec2::new(i as f64 + 0.5, 0.0),
+                inv_mass: 1.0,
+                inv_inertia: 12.0,
+                ..SolverBody::default()
+            })
+            .collect();
+        bodies.push(SolverBody::default());
+        let joints = (0..links)
+            .map(|i| JointConstraint {
+                joint: i as u32,
+                body_a: i as u32,
+                body_b: if i == 0 { anchor } else { i as u32 - 1 },
+                local_anchor_a: Vec2::new(-0.5, 0.0),
+                local_anchor_b: if i == 0 {
+                    Vec2::zeros()
+                } else {
+                    Vec2::new(0.5, 0.0)
+                },
+                motor: None,
+                gap_target: Vec2::zeros(),
+            })
+            .collect();
+        (bodies, joints)
+    }
+
+    /// An island of pins solved as one system factors its K only where its arms changed
+    /// (`IslandFactor`): the relax pass of one substep and the biased pass of the next
+    /// share a factor. The bodies must move as with K factored in every pass. A step
+    /// starts afresh: a chain hanging still has the same arms from step to step, to the
+    /// bit, and a mass changed between two steps must still reach its K.
+    #[test]
+    fn pins_factored_again_only_where_their_arms_changed_move_the_bodies_the_same() {
+        let settings = SoftSettings::for_length_scale(1.0);
+        let substeps = settings.substeps;
+        let steps = |gravity: Vec2, count: usize, every_pass: bool| {
+            let (mut bodies, mut joints) = rods(6);
+            let mut solver = SoftStepSolver::default();
+            solver.block.factor_every_pass = every_pass;
+            let gravity = vec![(gravity, 0.0); bodies.len()];
+            let mut bits = Vec::new();
+            for k in 0..count {
+                if k == count / 2 {
+                    bodies[3].inv_mass = 0.25;
+                }
+                let (mut contacts, h) = (Vec::new(), 1.0 / 60.0);
+                let (b, j) = (&mut bodies, &mut joints);
+                solver.step(&settings, b, &gravity, &mut contacts, j, h, 1.0);
+                bits.push(state_bits(&bodies, &[]));
+            }
+            (bits, solver.block.factored)
+        };
+        // Swinging down from level: every pass's arms are new but those after a relax pass.
+        let down = Vec2::new(0.0, 10.0);
+        let (shared, factored) = steps(down, 10, false);
+        let (every, factored_every) = steps(down, 10, true);
+        assert_eq!(shared, every);
+        assert_eq!(factored_every, 10 * 2 * substeps);
+        assert_eq!(factored, 10 * (substeps + 1));
+        // Pulled along its length, the chain hangs still: one factor a step, made afresh
+        // each step.
+        let along = Vec2::new(10.0, 0.0);
+        let (shared, factored) = steps(along, 4, false);
+        let (every, _) = steps(along, 4, true);
+        assert_eq!(shared, every);
+        assert_eq!(factored, 4);
+    }
+}

@@ -1,0 +1,863 @@
+//! The iterative "soft step" solver for big islands, after the design of Box2D v3:
+//! substeps with soft contact constraints (a stiffness in Hz with damping), a relax pass
+//! without bias, restitution once at the end above a speed threshold, warm starting from
+//! the last step's impulses, speculative contacts, and contact anchors fixed for the step.
+//!
+//! Each substep: integrate velocities, warm start / solve with bias, integrate positions,
+//! relax without bias. Contacts are found once per step; separations follow the bodies
+//! through the substeps by their anchors.
+//!
+//! This module holds the shared types and the stage list (`SoftStepSolver::step`); each
+//! stage is in the module named for it.
+
+use super::SolverBody;
+use super::contact::{Contact, ContactMemory};
+use super::island::IslandGrouping;
+use super::joint::JointConstraint;
+use super::simultaneous::IslandReport;
+use crate::math::{Rot, Vec2};
+use crate::stage_clock::{self, Stage};
+use batch::{LanePath, PassPlan, PassSettings, PlanInput};
+use pins::PinPlan;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
+mod batch;
+mod contact_lcp;
+mod contacts;
+mod joints;
+mod lanes;
+mod passes;
+mod pins;
+mod points;
+mod prepare;
+mod restitution;
+mod store;
+
+use contact_lcp::ContactLcp;
+use joints::{JointBlock, JointMemory};
+use passes::{integrate_position, integrate_velocity};
+
+/// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
+/// (eight f64 lanes a register), "AVX2" (four, a row of eight in two) or "portable"
+/// (plain arrays). The results are the same bits on each; the speed is not, so
+/// benchmarks name it beside the machine.
+pub fn lane_path_name() -> &'static str {
+    match LanePath::best() {
+        LanePath::Portable => "portable",
+        #[cfg(target_arch = "x86_64")]
+        LanePath::Avx2 => "AVX2",
+        #[cfg(target_arch = "x86_64")]
+        LanePath::Avx512 => "AVX-512",
+    }
+}
+
+/// Joint islands up to this many pins are solved as one linear system per pass (a dense
+/// Cholesky of 2m × 2m); larger ones pin by pin, in coloured batches (`pins`). One pass of
+/// pin-by-pin Gauss–Seidel cannot hold a light chain under a heavy load: the error
+/// travels one link per pass.
+const DIRECT_JOINT_LIMIT: usize = 64;
+
+/// Tuning of the soft step; defaults after Box2D v3, scaled by the world's length scale.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SoftSettings {
+    pub substeps: usize,
+    /// Contact stiffness (Hz), capped at a quarter of the substep rate for stability;
+    /// twice as stiff against a fixed body (as Box2D v3), which holds a pile up from
+    /// below: the 625 jammed discs of Box2D's Confined sample crept 138 mm over 8 s at
+    /// one stiffness, 6.7 mm at two.
+    pub contact_hertz: f64,
+    pub contact_damping_ratio: f64,
+    pub joint_hertz: f64,
+    pub joint_damping_ratio: f64,
+    /// The fastest a soft contact pushes overlapping bodies apart (length units / s).
+    pub max_push_speed: f64,
+    /// The deepest a soft contact lets its bodies sink in one substep's biased pass
+    /// (length units): see `sinking_floor`.
+    pub max_soft_depth: f64,
+    /// The fastest a soft pin pulls its anchors together (length units / s).
+    pub joint_push_speed: f64,
+    /// Whether every other pair of substeps sweeps the colours backwards (`SweepOrder`).
+    pub alternating_sweeps: bool,
+}
+
+impl SoftSettings {
+    pub(crate) fn for_length_scale(length_scale: f64) -> Self {
+        Self {
+            substeps: 4,
+            contact_hertz: 30.0,
+            contact_damping_ratio: 10.0,
+            joint_hertz: 60.0,
+            joint_damping_ratio: 2.0,
+            max_push_speed: 3.0 * length_scale,
+            max_soft_depth: 0.1 * length_scale,
+            // Far faster than contacts: a loaded net of pins (100 × 100, hanging from
+            // seven) opened to 16 m with pins capped at 3 length scales per second, and
+            // to 0.49 m (as Box2D v3's, which has no cap) at 100.
+            joint_push_speed: 100.0 * length_scale,
+            alternating_sweeps: true,
+        }
+    }
+}
+
+/// Mass and impulse scaling of a soft constraint (Box2D's b2Softness): a spring–damper of
+/// the given frequency and damping ratio, made implicit over the substep.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Softness {
+    bias_rate: f64,
+    mass_scale: f64,
+    impulse_scale: f64,
+}
+
+impl Softness {
+    fn new(hertz: f64, zeta: f64, h: f64) -> Self {
+        if hertz == 0.0 {
+            return Self {
+                bias_rate: 0.0,
+                mass_scale: 1.0,
+                impulse_scale: 0.0,
+            };
+        }
+        let omega = std::f64::consts::TAU * hertz;
+        let a1 = 2.0 * zeta + h * omega;
+        let a2 = h * omega * a1;
+        let a3 = 1.0 / (1.0 + a2);
+        Self {
+            bias_rate: omega / a1,
+            mass_scale: a2 * a3,
+            impulse_scale: a3,
+        }
+    }
+}
+
+/// A body during the soft step: velocity, inverse mass, and how far it moved this step.
+///
+/// Laid out for the batches' SIMD paths (`avx2::Avx2Lanes::gather`, `avx512`), which read
+/// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
+/// transpose them into lanes: the two rows start at 0 and 32 bytes. A body is 64-byte
+/// aligned, so that both rows lie in one cache line: at 96 bytes a body, every other one
+/// straddled two, and on the Zen 1, where a big pile's bodies do not stay in the level-2
+/// cache, large_pyramid's passes took 8–10% longer (docs/bench/profile.md).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C, align(64))]
+struct SoftBody {
+    v: Vec2,
+    w: f64,
+    inv_mass: f64,
+    /// Displacement and rotation since the start of the step.
+    dp: Vec2,
+    dq: Rot,
+    inv_inertia: f64,
+    dangle: f64,
+}
+
+/// Which four numbers of a body a batch reads together (`SoftBody::row`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum BodyRow {
+    /// `v.x, v.y, w, inv_mass`.
+    Velocity,
+    /// `dp.x, dp.y, dq.cos, dq.sin`.
+    Motion,
+}
+
+// The rows `SoftBody::row_offset` names.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    assert!(size_of::<Vec2>() == 16 && size_of::<Rot>() == 16);
+    assert!(offset_of!(SoftBody, v) == 0 && offset_of!(SoftBody, w) == 16);
+    assert!(offset_of!(SoftBody, inv_mass) == 24);
+    assert!(offset_of!(SoftBody, dp) == 32 && offset_of!(SoftBody, dq) == 48);
+    assert!(offset_of!(Rot, cos) == 0 && offset_of!(Rot, sin) == 8);
+    assert!(std::mem::align_of::<SoftBody>() == 64 && size_of::<SoftBody>() == 128);
+};
+
+impl SoftBody {
+    /// The four numbers of `row`, in its order.
+    fn row(&self, row: BodyRow) -> [f64; 4] {
+        match row {
+            BodyRow::Velocity => [self.v.x, self.v.y, self.w, self.inv_mass],
+            BodyRow::Motion => [self.dp.x, self.dp.y, self.dq.cos, self.dq.sin],
+        }
+    }
+
+    /// Where `row` starts, in f64s from the start of the body (the layout asserted below
+    /// the struct).
+    #[cfg(target_arch = "x86_64")]
+    const fn row_offset(row: BodyRow) -> usize {
+        match row {
+            BodyRow::Velocity => 0,
+            BodyRow::Motion => 4,
+        }
+    }
+
+    /// The body a batch's unused lanes point at: fixed and at rest.
+    fn null() -> Self {
+        Self {
+            dq: Rot { cos: 1.0, sin: 0.0 },
+            ..Self::default()
+        }
+    }
+
+    /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
+    fn moves(&self) -> bool {
+        self.inv_mass > 0.0 || self.inv_inertia > 0.0
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct PointConstraint {
+    contact: u32,
+    a: u32,
+    b: u32,
+    normal: Vec2,
+    /// The anchors' levers about the normal and the tangent (`r × n`, `r × t` on A and
+    /// on B), fixed for the step like the anchors: a row's velocity and impulse use them
+    /// instead of crossing the arms again at every pass.
+    levers: PointLevers,
+    /// Separation at the start, minus the anchors' part, so that the current separation is
+    /// `n·(Δ(p_a + r_a) − Δ(p_b + r_b)) + base_separation`.
+    base_separation: f64,
+    normal_mass: f64,
+    tangent_mass: f64,
+    friction: f64,
+    restitution: f64,
+    relative_velocity: f64,
+    normal_impulse: f64,
+    tangent_impulse: f64,
+    max_normal_impulse: f64,
+    /// How fast gravity and forces close the gap (along −normal), for the impact speed.
+    closing_acceleration: f64,
+    /// The fastest impact `approach` may record: the approach at the step's start plus
+    /// what the closing acceleration adds over the step. Any faster is speed the step's
+    /// other contacts gave the bodies, which a bounce must not return: a small body
+    /// wedged between a wall and another body gained half its speed again each step,
+    /// bounced off the one and the other in turn.
+    fastest_impact: f64,
+    /// With the next point: their 2 × 2 normal mass matrix, when the two are one
+    /// manifold's and the block is well conditioned (solved together).
+    pair_coupling: Option<NormalBlock>,
+}
+
+/// The 2 × 2 normal mass matrix K of a manifold's two points and its inverse, computed
+/// once per step so that the passes do not divide.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct NormalBlock {
+    k11: f64,
+    k12: f64,
+    k22: f64,
+    inverse: (f64, f64, f64),
+}
+
+impl NormalBlock {
+    /// The block of two points `p`, `q` of one manifold between bodies `a` and `b`, if it
+    /// is well conditioned.
+    fn of(
+        pair: (&SoftBody, &SoftBody),
+        (p, q): (&PointConstraint, &PointConstraint),
+    ) -> Option<Self> {
+        Self::of_levers(pair, (p.levers.normal, q.levers.normal))
+    }
+
+    /// `of` for two points whose normal levers (`PointLevers::normal`) are `l1` and `l2`.
+    #[inline(always)]
+    fn of_levers(
+        (a, b): (&SoftBody, &SoftBody),
+        (l1, l2): ((f64, f64), (f64, f64)),
+    ) -> Option<Self> {
+        // Multiplied out again rather than taken as 1 / normal_mass, and the inverse
+        // from one reciprocal: divisions were the slowest part of building the points.
+        let m = a.inv_mass + b.inv_mass;
+        let inertias = (a.inv_inertia, b.inv_inertia);
+        let k11 = row_coupling(m, inertias, l1, l1);
+        let k12 = row_coupling(m, inertias, l1, l2);
+        let k22 = row_coupling(m, inertias, l2, l2);
+        let det = k11.mul_add(k22, -(k12 * k12));
+        (k11 > 0.0 && k22 > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det).then(|| {
+            let inv_det = 1.0 / det;
+            Self {
+                k11,
+                k12,
+                k22,
+                inverse: (k22 * inv_det, -k12 * inv_det, k11 * inv_det),
+            }
+        })
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct PointLevers {
+    normal: (f64, f64),
+    /// `r · n` on A and on B: how far each anchor reaches along the normal. Also the
+    /// tangent row's levers: r × perp(n) = r · n.
+    reach: (f64, f64),
+}
+
+impl PointLevers {
+    /// The levers of contact `c` about its bodies' centroids at the step's start.
+    #[inline(always)]
+    fn of(bodies: &[SolverBody], c: &Contact) -> Self {
+        let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+        let n = c.normal;
+        let (r_a, r_b) = (c.point - a.position, c.point - b.position);
+        // r × n and r · n, each product added with one rounding (see `BodyPair`).
+        let lever = |r: Vec2| r.x.mul_add(n.y, -(r.y * n.x));
+        let reach = |r: Vec2| r.y.mul_add(n.y, r.x * n.x);
+        Self {
+            normal: (lever(r_a), lever(r_b)),
+            reach: (reach(r_a), reach(r_b)),
+        }
+    }
+
+    /// The tangent row's lever arms, r × t with t = perp(n): the reach, r · n.
+    fn tangent(&self) -> (f64, f64) {
+        self.reach
+    }
+}
+
+/// J M⁻¹ Jᵀ of two rows along one direction between the same two bodies: `inv_masses` the
+/// bodies' summed inverse masses, `inertias` their inverse inertias, and each row's levers
+/// (`r × n` on A and on B). With one row twice, the inverse of its effective mass.
+#[inline(always)]
+fn row_coupling(
+    inv_masses: f64,
+    (ia, ib): (f64, f64),
+    (a1, b1): (f64, f64),
+    (a2, b2): (f64, f64),
+) -> f64 {
+    (ib * b1).mul_add(b2, (ia * a1).mul_add(a2, inv_masses))
+}
+
+/// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
+/// condition number below this (Box2D v2's bound); nearly parallel rows go one by one.
+const MAX_BLOCK_CONDITION: f64 = 1000.0;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SoftJoint {
+    a: u32,
+    b: u32,
+    r_a: Vec2,
+    r_b: Vec2,
+    /// Anchor separation at the start of the step (A − B).
+    base_gap: Vec2,
+    impulse: Vec2,
+    motor_impulse: f64,
+    /// The motor's angular impulse summed over this step's substeps.
+    motor_step_total: f64,
+    motor: Option<(f64, f64)>,
+    slot: u32,
+    /// Its index in the step's input joints (the solver reorders them by island).
+    input: u32,
+}
+
+/// Warm-start memory and buffers, kept between steps.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SoftStepSolver {
+    bodies: Vec<SoftBody>,
+    points: Vec<PointConstraint>,
+    joints: Vec<SoftJoint>,
+    spare_joints: Vec<SoftJoint>,
+    /// Last step's contact impulses, recalled as this step's points are built.
+    memory: ContactMemory,
+    /// Each contact's impulses from the last step (`ContactMemory::recall`).
+    recalled: Vec<(f64, f64)>,
+    /// Each contact's impulses from this step, gathered from the lanes and the points
+    /// before they go into the contacts in one sweep (`store`).
+    impulses: Vec<(f64, f64)>,
+    joint_memory: JointMemory,
+    /// The pinned bodies' rotations at the step's start, found as the pins need them.
+    rotations: Vec<Option<Rot>>,
+    /// `joints` indices of the pins with a motor, in `joints`' order.
+    motor_joints: Vec<u32>,
+    /// By body, whether a pin joins it (empty if there are no pins): such a body's
+    /// island is solved with the rest, not in a chunk (`PassPlan::assign_chunks`).
+    pinned: Vec<bool>,
+    /// Whether a fixed body has a velocity this step (a static body the caller set moving):
+    /// its motion counts in every substep of the islands it touches, which a chunk solved
+    /// apart would not see, so the chunks are then solved with the rest.
+    a_fixed_body_moves: bool,
+    /// `points` index ranges, one per island of contacts.
+    contact_islands: Vec<(usize, usize)>,
+    /// `joints` index ranges, one per island of pins, and the buffers of their solve.
+    joint_islands: Vec<(usize, usize)>,
+    /// The big pin islands' batches (`pins`).
+    pin_plan: PinPlan,
+    /// The contacts' islands, kept while the contacts stay between the same bodies.
+    contact_grouping: IslandGrouping,
+    /// The pins' islands, kept while the pins join the same bodies.
+    joint_grouping: IslandGrouping,
+    block: JointBlock,
+    contact_lcp: ContactLcp,
+    /// The passes' order over the manifolds outside the LCP islands, and what it is made
+    /// from: each manifold's entry, noted as its points are built.
+    plan: PassPlan,
+    plan_inputs: Vec<PlanInput>,
+    /// The entries a plan made before the points were built was made from
+    /// (`plan_from_contacts`).
+    planned_inputs: Vec<PlanInput>,
+    /// Whether any point has restitution: a pile has none, and skips the pass over its
+    /// points that looks for bounces.
+    may_bounce: bool,
+    /// Substeps taken since the solver was made: they choose each substep's
+    /// `SweepOrder`.
+    substeps_taken: u64,
+    /// How each island was solved in the last step.
+    pub reports: Vec<IslandReport>,
+    /// Tests only: every point written, as if no manifold went straight into its lane.
+    #[cfg(test)]
+    pub(crate) write_every_point: bool,
+    /// Tests only: steps that left points unwritten, and steps that built them again.
+    #[cfg(test)]
+    pub(crate) steps_skipping: (usize, usize),
+    /// Tests only: steps that made their plan before their points.
+    #[cfg(test)]
+    pub(crate) steps_planned_first: usize,
+}
+
+/// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
+/// big islands (the small ones keep the points' order: a stack's bottom first, which
+/// holds the sweep's stacks a little closer to their rest).
+///
+/// Gauss–Seidel leaves the constraints it solved last best satisfied: swept always
+/// first to last, the colours favour some constraints over others at every step. Two
+/// substeps forwards, then two backwards, cancel that to first order (symmetric
+/// Gauss–Seidel). With the colours given in the points' order, it took the 100-row
+/// pyramid's largest top sway from 0.23 of a box to 0.022; flipping every substep helped
+/// less (0.086), flipping only the relax pass less still (0.15). With the colours
+/// scattered (`batch::PassPlan::colour_in_scattered_order`) the sway is 0.0065 swept one
+/// way and 0.0025 alternating (Box2D v3: 0.0094): see docs/bench/profile.md.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SweepOrder {
+    Forwards,
+    Backwards,
+}
+
+impl SweepOrder {
+    /// Counted across steps, so that a step of one or two substeps alternates too.
+    fn of_substep(substep: u64) -> Self {
+        // Bit 1 of the count: two substeps one way, two the other.
+        if substep & 2 == 0 {
+            Self::Forwards
+        } else {
+            Self::Backwards
+        }
+    }
+}
+
+/// The most a body may turn in one substep (radians).
+const MAX_TURN_PER_SUBSTEP: f64 = 0.25 * std::f64::consts::PI;
+
+/// Soft constraints are capped at a quarter of the substep rate for stability.
+const MAX_HERTZ_PER_SUBSTEP_RATE: f64 = 0.25;
+
+/// A contact pass's settings for substeps of `h`.
+fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool) -> PassSettings {
+    PassSettings {
+        inv_h: 1.0 / h,
+        soft: *soft,
+        static_soft: Softness::new(
+            (2.0 * settings.contact_hertz).min(MAX_HERTZ_PER_SUBSTEP_RATE / h),
+            settings.contact_damping_ratio,
+            h,
+        ),
+        max_push: settings.max_push_speed,
+        max_depth: settings.max_soft_depth,
+        use_bias,
+    }
+}
+
+impl SoftStepSolver {
+    /// Advances `bodies` by `dt`: velocities from `accelerations` (linear, angular per
+    /// body), constraints from `contacts` and `joints`, positions and angles integrated.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn step(
+        &mut self,
+        settings: &SoftSettings,
+        bodies: &mut [SolverBody],
+        accelerations: &[(Vec2, f64)],
+        contacts: &mut [Contact],
+        joints: &mut [JointConstraint],
+        dt: f64,
+        bounce_below: f64,
+    ) {
+        let h = dt / settings.substeps as f64;
+        let contact_soft = Softness::new(
+            settings.contact_hertz.min(MAX_HERTZ_PER_SUBSTEP_RATE / h),
+            settings.contact_damping_ratio,
+            h,
+        );
+        let joint_soft = Softness::new(
+            settings.joint_hertz.min(MAX_HERTZ_PER_SUBSTEP_RATE / h),
+            settings.joint_damping_ratio,
+            h,
+        );
+        let started = stage_clock::mark();
+        self.prepare(bodies, accelerations, contacts, joints, dt);
+        stage_clock::record(Stage::Preparing, started);
+        let sweep_order = |substep: u64| {
+            if settings.alternating_sweeps {
+                SweepOrder::of_substep(substep)
+            } else {
+                SweepOrder::Forwards
+            }
+        };
+        // Chunks of islands first, each through every substep while its batches stay in
+        // the cache (`PassPlan::assign_chunks`), then the rest substep by substep.
+        let pass = |use_bias| contact_pass(h, &contact_soft, settings, use_bias);
+        for k in 0..self.chunks_apart() {
+            let items = self.plan.chunk(k).0;
+            for substep in 0..settings.substeps {
+                let order = sweep_order(self.substeps_taken.wrapping_add(substep as u64));
+                for &i in self.plan.chunk(k).1 {
+                    let i = i as usize;
+                    integrate_velocity(&mut self.bodies[i], accelerations[i], h);
+                }
+                let started = stage_clock::mark();
+                // The first substep's passes read the chunk's batches from farther out and
+                // ask for each next one (`BatchesAhead`); the later ones find them in the
+                // level-2 cache, where asking only costs (many_pyramids' solve 7% slower).
+                let ask = substep == 0;
+                self.warm_start_items(items.clone(), ask);
+                stage_clock::record(Stage::WarmStart, started);
+                let started = stage_clock::mark();
+                self.sweep_items(items.clone(), &pass(true), order, ask);
+                for &i in self.plan.chunk(k).1 {
+                    integrate_position(&mut self.bodies[i as usize], h);
+                }
+                self.sweep_items(items.clone(), &pass(false), order, false);
+                stage_clock::record(Stage::Solve, started);
+            }
+        }
+        for _ in 0..settings.substeps {
+            let order = sweep_order(self.substeps_taken);
+            self.substeps_taken = self.substeps_taken.wrapping_add(1);
+            self.integrate_velocities(accelerations, h);
+            let started = stage_clock::mark();
+            self.warm_start();
+            stage_clock::record(Stage::WarmStart, started);
+            let started = stage_clock::mark();
+            self.solve(h, &contact_soft, &joint_soft, settings, true, order);
+            self.integrate_positions(h);
+            self.solve(h, &contact_soft, &joint_soft, settings, false, order);
+            stage_clock::record(Stage::Solve, started);
+            // Warm starting re-applies the accumulated impulse in every substep, so the
+            // step's total is the sum of the substeps' accumulated values.
+            for &k in &self.motor_joints {
+                let j = &mut self.joints[k as usize];
+                j.motor_step_total += j.motor_impulse;
+            }
+        }
+        if self.may_bounce {
+            // Restitution works on the points: they take the batches' impulses first.
+            self.plan.scatter(&mut self.points);
+            self.restitution(bounce_below);
+        }
+        self.pin_plan.scatter(&mut self.joints);
+        let started = stage_clock::mark();
+        self.store(bodies, contacts, joints);
+        stage_clock::record(Stage::Storing, started);
+        self.report();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collide::FeatureId;
+
+    /// Boxes in columns on a fixed floor (the last body), and each box's two points on
+    /// the body below it: the columns' heights, their boxes numbered from the first
+    /// column's bottom up.
+    fn columns(heights: &[usize]) -> (Vec<SolverBody>, Vec<Contact>) {
+        let count: usize = heights.iter().sum();
+        let floor = count as u32;
+        let (mut bodies, mut contacts) = (vec![], vec![]);
+        for (column, &height) in heights.iter().enumerate() {
+            let x = 3.0 * column as f64;
+            for row in 0..height {
+                let below = if row == 0 {
+                    floor
+                } else {
+                    bodies.len() as u32 - 1
+                };
+                let y = -(row as f64);
+                for (dx, id) in [(-0.5, 1), (0.5, 2)] {
+                    contacts.push(Contact {
+                        body_a: bodies.len() as u32,
+                        body_b: below,
+                        point: Vec2::new(x + dx, y),
+                        normal: Vec2::new(0.0, -1.0),
+                        depth: 0.004,
+                        id: FeatureId(id),
+                        restitution: 0.0,
+                        friction: 0.6,
+                        approach_velocity: 0.0,
+                        normal_velocity: 0.0,
+                        normal_impulse: 0.0,
+                        tangent_impulse: 0.0,
+                    });
+                }
+                bodies.push(SolverBody {
+                    position: Vec2::new(x, y - 0.5),
+                    inv_mass: 1.0,
+                    inv_inertia: 6.0,
+                    ..SolverBody::default()
+                });
+            }
+        }
+        bodies.push(SolverBody::default());
+        (bodies, contacts)
+    }
+
+    /// One step of 1/60 s of `bodies` under gravity (10 m/s² down every body) with a copy
+    /// of `contacts`, which it returns with the step's impulses.
+    fn step_falling(
+        solver: &mut SoftStepSolver,
+        bodies: &mut [SolverBody],
+        contacts: &[Contact],
+    ) -> Vec<Contact> {
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let mut contacts = contacts.to_vec();
+        let mut joints = [];
+        let h = 1.0 / 60.0;
+        solver.step(
+            &settings,
+            bodies,
+            &accelerations,
+            &mut contacts,
+            &mut joints,
+            h,
+            1.0,
+        );
+        contacts
+    }
+
+    /// Every body's velocity and pose and every contact's impulses, bit for bit.
+    pub(super) fn state_bits(bodies: &[SolverBody], contacts: &[Contact]) -> Vec<u64> {
+        let states = bodies.iter().flat_map(|b| {
+            let (v, p) = (b.velocity, b.position);
+            [v.x, v.y, b.angular_velocity, p.x, p.y, b.angle]
+        });
+        let impulses = contacts
+            .iter()
+            .flat_map(|c| [c.normal_impulse, c.tangent_impulse]);
+        states.chain(impulses).map(f64::to_bits).collect()
+    }
+
+    /// A solver stepped `steps` times (`step_falling`) beside one that writes every point
+    /// and plans from them, with the two contact lists in turn; both must leave the
+    /// bodies and the impulses the same, bit for bit, after every step. Returns the two.
+    fn step_beside_one_writing_every_point(
+        bodies: Vec<SolverBody>,
+        contacts_in_turn: [&[Contact]; 2],
+        steps: usize,
+    ) -> (SoftStepSolver, SoftStepSolver) {
+        let mut solver = SoftStepSolver::default();
+        let mut writing = SoftStepSolver {
+            write_every_point: true,
+            ..SoftStepSolver::default()
+        };
+        let (mut bodies_solver, mut bodies_writing) = (bodies.clone(), bodies);
+        for k in 0..steps {
+            let contacts = contacts_in_turn[k % 2];
+            let contacts_solver = step_falling(&mut solver, &mut bodies_solver, contacts);
+            let contacts_writing = step_falling(&mut writing, &mut bodies_writing, contacts);
+            assert_eq!(
+                state_bits(&bodies_solver, &contacts_solver),
+                state_bits(&bodies_writing, &contacts_writing),
+                "step {k}"
+            );
+        }
+        (solver, writing)
+    }
+
+    /// After a step whose plan changed, the next plan is made from the contacts before the
+    /// points are built, and each manifold goes straight into its lane. That must solve
+    /// exactly as a solver that writes every point first and plans from them, through
+    /// steps whose coloured island changes every time, with a manifold whose two points
+    /// lie on one spot (its 2 × 2 block singular: two one-point manifolds) in it.
+    #[test]
+    fn a_plan_made_before_the_points_solves_as_one_made_after() {
+        let (bodies, mut whole) = columns(&[30, 10, 1]);
+        // Box 12's two points (contacts 24 and 25) on one spot.
+        whole[25].point = whole[24].point;
+        // Without the tall column's top box's contacts: the coloured island's plan
+        // changes at every step.
+        let mut topless = whole.clone();
+        topless.drain(58..60);
+        let (first, after) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 8);
+        // Every step: each changes the plan (the first makes one).
+        assert_eq!(first.steps_planned_first, 8);
+        assert_eq!(after.steps_planned_first, 0);
+        // The singular manifold went as two one-point manifolds.
+        let around = first.plan_inputs.iter().map(|p| p.first_and_count());
+        let around: Vec<_> = around.filter(|&(k, _)| (22..28).contains(&k)).collect();
+        assert_eq!(around, [(22, 2), (24, 1), (25, 1), (26, 2)]);
+    }
+
+    /// Coloured islands solved in chunks, each through every substep before the next
+    /// (`PassPlan::assign_chunks`), must move every body exactly as the whole step solved
+    /// substep by substep: the islands share no moving body. Four coloured columns, one
+    /// of them with two boxes pinned together (its island stays with the rest, whose pins
+    /// are solved with their contacts), a taller one (too big for a chunk: with the rest
+    /// too), a column of two boxes and a box alone (6 points together: solved one
+    /// manifold at a time), through steps whose plan changes and steps that keep it; then
+    /// with the floor moving (a fixed body with a velocity, whose motion each island must
+    /// see substep by substep: the chunks are then solved with the rest).
+    #[test]
+    fn islands_solved_in_chunks_move_as_when_solved_together() {
+        let (bodies, whole) = columns(&[30, 30, 30, 30, 40, 2, 1]);
+        // Without the first column's top box's contacts: the plan changes every other step.
+        let mut topless = whole.clone();
+        topless.drain(58..60);
+        // Boxes 95 and 96, in the fourth column, pinned at the corner they share.
+        let mut joints = [JointConstraint {
+            joint: 0,
+            body_a: 95,
+            body_b: 96,
+            local_anchor_a: Vec2::new(0.5, -0.5),
+            local_anchor_b: Vec2::new(0.5, 0.5),
+            motor: None,
+            gap_target: Vec2::zeros(),
+        }];
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let mut chunked = SoftStepSolver::default();
+        // Every coloured island in a chunk of its own: a chunk holds one column's batches.
+        let column = 30 * std::mem::size_of::<batch::ManifoldBatch<2>>() / lanes::LANES;
+        chunked.plan.chunk_limits = Some((0, column));
+        let mut together = SoftStepSolver::default();
+        together.plan.chunk_limits = Some((usize::MAX, 0));
+        let floor = bodies.len() - 1;
+        let (mut bodies_chunked, mut bodies_together) = (bodies.clone(), bodies);
+        for k in 0..12 {
+            let contacts = [&whole, &topless][k / 2 % 2];
+            let floor_moves = k >= 8;
+            if floor_moves {
+                bodies_chunked[floor].velocity = Vec2::new(0.3, 0.2);
+                bodies_together[floor].velocity = Vec2::new(0.3, 0.2);
+            }
+            let mut step = |solver: &mut SoftStepSolver, bodies: &mut [SolverBody]| {
+                let mut contacts = contacts.to_vec();
+                let h = 1.0 / 60.0;
+                let a = &accelerations;
+                solver.step(&settings, bodies, a, &mut contacts, &mut joints, h, 1.0);
+                contacts
+            };
+            let contacts_chunked = step(&mut chunked, &mut bodies_chunked);
+            let contacts_together = step(&mut together, &mut bodies_together);
+            assert_eq!(
+                state_bits(&bodies_chunked, &contacts_chunked),
+                state_bits(&bodies_together, &contacts_together),
+                "step {k}"
+            );
+            // The three columns without a pin, a chunk each, solved apart while the floor
+            // stands; none for the other solver.
+            assert_eq!(
+                (chunked.plan.chunk_count(), together.plan.chunk_count()),
+                (3, 0)
+            );
+            let apart = if floor_moves { 0 } else { 3 };
+            assert_eq!(
+                (chunked.chunks_apart(), together.chunks_apart()),
+                (apart, 0)
+            );
+        }
+        // The pinned island's boxes, the tall column's, the small column's and the box
+        // alone (the last box before the floor) were moved by the rest's passes, the other
+        // columns' by the chunks'.
+        let in_chunk = |boxes: [usize; 2]| boxes.map(|i| chunked.plan.in_chunk(i));
+        assert_eq!(in_chunk([0, 31]), [true, true]);
+        assert_eq!(in_chunk([95, 96]), [false, false]);
+        assert_eq!(in_chunk([120, 159]), [false, false]);
+        assert_eq!(in_chunk([160, floor - 1]), [false, false]);
+    }
+
+    /// A step with a point that may bounce reads every point for its restitution, so it
+    /// plans after building them all, as before, even where only a manifold's second
+    /// point may bounce.
+    #[test]
+    fn a_point_that_may_bounce_keeps_the_plan_after_the_points() {
+        let (bodies, mut whole) = columns(&[30]);
+        // Box 20's second point (contact 41) bouncy, its first not.
+        whole[41].restitution = 0.5;
+        whole[41].approach_velocity = -2.0;
+        let mut topless = whole.clone();
+        topless.drain(58..60);
+        let (solver, _) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 6);
+        assert_eq!(solver.steps_planned_first, 0);
+    }
+
+    /// A step whose contacts join other bodies than the last step's, as many of them and
+    /// with every body as free as before, takes the last grouping unchecked and must find
+    /// that out as it builds the points (some of them into the kept plan's lanes): it must
+    /// move the bodies exactly as a solver that grouped them afresh, and end with their
+    /// grouping.
+    #[test]
+    fn contacts_on_other_bodies_are_grouped_again() {
+        // A column of 30 boxes (60 points), one of 10 (20 points), both coloured into
+        // batches, and a box alone (2 points, solved one manifold at a time).
+        let (bodies, standing) = columns(&[30, 10, 1]);
+        // Box 35 on box 20 instead of box 34: the two columns' islands change.
+        let mut moved = standing.clone();
+        for c in &mut moved[70..72] {
+            c.body_b = 20;
+        }
+        // The box alone on box 39 instead of the floor: the last island (in the grouping
+        // taken unchecked) joins another.
+        let mut last_moved = standing.clone();
+        for c in &mut last_moved[80..82] {
+            c.body_b = 39;
+        }
+        // Only a manifold's second point on another body (box 8 instead of box 9), in
+        // the same island.
+        let mut second_moved = standing.clone();
+        second_moved[21].body_b = 8;
+        // The first steps' contacts and the last step's, whether the last step's grouping
+        // is the first steps' kept unchecked, and whether it is another.
+        let cases = [
+            (&standing, &standing, true, false),
+            (&standing, &moved, false, true),
+            (&standing, &last_moved, false, true),
+            (&standing, &second_moved, false, false), // the same islands
+            (&second_moved, &standing, false, false), // the second point joins the first
+        ];
+        for (first, last, kept, changes) in cases {
+            let (mut unchecked, mut fresh) = (SoftStepSolver::default(), SoftStepSolver::default());
+            let (mut bodies_unchecked, mut bodies_fresh) = (bodies.clone(), bodies.clone());
+            // Steps enough for the plan to be kept, and its lanes filled as the points
+            // are built.
+            for _ in 0..4 {
+                step_falling(&mut unchecked, &mut bodies_unchecked, first);
+                step_falling(&mut fresh, &mut bodies_fresh, first);
+            }
+            assert!(
+                unchecked.steps_skipping.0 > 0,
+                "no lane was filled unwritten"
+            );
+            let first_grouping = unchecked.contact_grouping.grouped().to_vec();
+            fresh.contact_grouping = IslandGrouping::default();
+            let contacts_unchecked = step_falling(&mut unchecked, &mut bodies_unchecked, last);
+            let contacts_fresh = step_falling(&mut fresh, &mut bodies_fresh, last);
+            assert_eq!(
+                state_bits(&bodies_unchecked, &contacts_unchecked),
+                state_bits(&bodies_fresh, &contacts_fresh)
+            );
+            let grouping = unchecked.contact_grouping.grouped();
+            assert_eq!(grouping, fresh.contact_grouping.grouped());
+            assert_eq!(grouping != first_grouping, changes);
+            assert_eq!(unchecked.contact_grouping.kept(), kept);
+            // The tall column's every box pushed: the step solved what it was given.
+            let pushes = contacts_unchecked[..60]
+                .chunks(2)
+                .map(|m| m[0].normal_impulse + m[1].normal_impulse);
+            assert!(
+                pushes.clone().all(|p| p > 0.0),
+                "{:?}",
+                pushes.collect::<Vec<_>>()
+            );
+        }
+    }
+}
