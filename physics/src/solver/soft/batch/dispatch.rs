@@ -28,7 +28,7 @@ impl LanePath {
     /// register a lane row) and in AVX2 (whose pass skips an unused upper half; two or
     /// three made the same instructions on the 20-row pyramid and the smash), six in the
     /// portable lanes.
-    pub(in crate::solver::soft) fn fewest_padded(self) -> usize {
+    pub(super) fn fewest_padded(self) -> usize {
         match self {
             #[cfg(target_arch = "x86_64")]
             Self::Avx512 | Self::Avx2 => 3,

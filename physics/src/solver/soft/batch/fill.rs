@@ -92,7 +92,7 @@ impl<const N: usize> ManifoldBatch<N> {
     }
 
     /// The accumulated impulses, into `impulses` at the lanes' contacts.
-    pub(in crate::solver::soft) fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
+    pub(super) fn store_impulses(&self, impulses: &mut [(f64, f64)]) {
         let points = self.points.iter().zip(&self.normal_impulses);
         for ((lanes, normal), indices) in points.zip(&self.contacts) {
             for (k, &index) in indices.iter().enumerate().filter(|&(_, &i)| i != PAD) {
@@ -102,7 +102,7 @@ impl<const N: usize> ManifoldBatch<N> {
     }
 
     /// Writes what the passes changed back to the batch's points.
-    pub(in crate::solver::soft) fn scatter(&self, points: &mut [PointConstraint]) {
+    pub(super) fn scatter(&self, points: &mut [PointConstraint]) {
         for (which, (lp, lb)) in self.points.iter().zip(&self.bounce).enumerate() {
             let normal = self.normal_impulses[which].0;
             let tangent = lp.tangent_impulse.0;
