@@ -62,9 +62,9 @@ impl SoftStepSolver {
         }
     }
 
-    /// The contacts' islands: last step's grouping taken unchecked where its bodies are
-    /// kept (see below), else grouped afresh. Returns it and whether it was kept; it goes
-    /// back to `contact_grouping` once the points are built (`prepare_points`).
+    /// The contacts' islands: last step's grouping, taken unchecked where
+    /// `IslandGrouping::bodies_kept` allows (the points check it as they are built), else
+    /// grouped afresh. Returns it and whether it was kept; `prepare_points` puts it back.
     fn take_contact_grouping(
         &mut self,
         contacts: &[Contact],
