@@ -111,7 +111,35 @@ pub(crate) struct SimultaneousSolver {
     regularisation: f64,
     /// `StepSettings::dense_row_limit`, copied in before each solve.
     pub dense_row_limit: usize,
+    /// `StepSettings::propagate_impacts`, copied in before each solve.
+    pub propagate_impacts: bool,
+    /// The island's body pairs: each one's span of `island_contacts` (a manifold's points
+    /// come one after another).
+    pair_spans: Vec<(usize, usize)>,
+    /// Which pairs the impact pass bounced.
+    bounced: Vec<bool>,
+    /// The pins of the island without their motors, for the impact pass.
+    impact_joints: Vec<JointConstraint>,
+    /// One pair's contacts as the impact pass solves them.
+    impact_contacts: Vec<(u32, Contact)>,
+    /// The (normal, tangent) impulses the impact pass gave each of the island's contacts.
+    impact_impulses: Vec<(f64, f64)>,
 }
+
+/// Whether the bodies' velocities already hold the step's forces (`exact`: a contact's
+/// `normal_velocity` is the velocity now, its `approach_velocity` the one before the
+/// forces) or not yet (the soft step, whose forces act in its substeps: the approach is
+/// the velocity now, and `normal_velocity` adds the forces' share).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kick {
+    Applied,
+    Pending,
+}
+
+/// The most times the impact pass solves a body pair, on average over the island's pairs,
+/// before it leaves what still bounces to the simultaneous solve: a row of n touching
+/// bodies passes one impact on in n solves, a column bouncing on the floor in about 2n.
+const IMPACT_SOLVES_PER_PAIR: usize = 8;
 
 impl SimultaneousSolver {
     /// Solves every island and applies the impulses to `bodies`; contacts get their normal
@@ -132,13 +160,68 @@ impl SimultaneousSolver {
         self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
         for island in 0..self.ranges.len() {
             self.load_island(island, contacts, joints);
+            self.impact_impulses.clear();
             match model {
                 FrictionModel::TwoStage => self.solve_two_stage(bodies, targets),
-                FrictionModel::Coupled => self.solve_coupled(bodies, targets),
+                FrictionModel::Coupled => {
+                    if self.propagate_impacts {
+                        self.propagate_impacts(bodies, targets, Kick::Applied);
+                    }
+                    self.solve_coupled(bodies, targets);
+                }
             }
             self.write_back(contacts, joints);
         }
         self.memory.store(contacts);
+    }
+
+    /// The impact pass (`propagate_impacts`) on every island, for a solver that bounces
+    /// contacts its own way (the soft step): the pairs it bounced get no restitution
+    /// from that solver this step.
+    pub(crate) fn propagate_all_impacts(
+        &mut self,
+        contacts: &mut [Contact],
+        joints: &[JointConstraint],
+        bodies: &mut [SolverBody],
+        targets: &VelocityTargets,
+    ) {
+        // As in `propagate_impacts`: and the soft step's own bounce off a fixed body places
+        // it better (at the surface, not where the pair was at the step's start).
+        if !contacts.iter().any(|c| passes_on(c, bodies, targets)) {
+            return;
+        }
+        self.group(contacts, joints, true, bodies);
+        for island in 0..self.ranges.len() {
+            self.load_island(island, contacts, joints);
+            if !self
+                .island_contacts
+                .iter()
+                .any(|(_, c)| passes_on(c, bodies, targets))
+            {
+                continue;
+            }
+            self.impact_impulses.clear();
+            self.propagate_impacts(bodies, targets, Kick::Pending);
+            if !self.bounced.contains(&true) {
+                continue;
+            }
+            // The island's velocities changed: its contacts' approaches are read again.
+            for &(i, c) in &self.island_contacts {
+                let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+                let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
+                let contact = &mut contacts[i as usize];
+                let kick = contact.normal_velocity - contact.approach_velocity;
+                contact.approach_velocity = now;
+                contact.normal_velocity = now + kick;
+            }
+            for (p, &(start, end)) in self.pair_spans.iter().enumerate() {
+                if self.bounced[p] {
+                    for &(i, _) in &self.island_contacts[start..end] {
+                        contacts[i as usize].restitution = 0.0;
+                    }
+                }
+            }
+        }
     }
 
     /// Starting impulses for the rows from the last solve's, for contacts that persist.
@@ -345,6 +428,153 @@ impl SimultaneousSolver {
         self.solve_rows(bodies, true);
     }
 
+    /// The island's impacts, body pair by body pair (`StepSettings::propagate_impacts`),
+    /// instead of in the island's one LCP with everything else (the thesis's model, which
+    /// shares an impulse through every contact at once: a Newton's cradle moves off as a
+    /// block). An impact travels through bodies at rest in contact as a shock does: each pair
+    /// with a point that meets fast enough to bounce is solved alone with the island's pins
+    /// (normals, friction and pins in one small LCP), in order, sweep after sweep, until
+    /// no pair bounces; then the pairs that bounced are marked as not bouncing, so that the
+    /// simultaneous solve only holds them apart. A pair reflects its approach as it is when
+    /// its turn comes, less this step's gravity kick (`Contact::approach_velocity`).
+    fn propagate_impacts(
+        &mut self,
+        bodies: &mut [SolverBody],
+        targets: &VelocityTargets,
+        kick: Kick,
+    ) {
+        let (dt, bounce_below) = (targets.dt, targets.bounce_below);
+        self.pair_spans.clear();
+        self.bounced.clear();
+        // Only where two moving bodies meet at speed; a body bouncing off a fixed one alone
+        // passes nothing on, and is left to the simultaneous solve as before (a robot's feet
+        // landing together, whose solve the pair-by-pair pass would change).
+        if !self
+            .island_contacts
+            .iter()
+            .any(|(_, c)| passes_on(c, bodies, targets))
+        {
+            return;
+        }
+        let mut k = 0;
+        while k < self.island_contacts.len() {
+            let pair = |c: &Contact| (c.body_a, c.body_b);
+            let first = pair(&self.island_contacts[k].1);
+            let n = self.island_contacts[k..]
+                .iter()
+                .take_while(|(_, c)| pair(c) == first)
+                .count();
+            self.pair_spans.push((k, k + n));
+            k += n;
+        }
+        self.bounced.resize(self.pair_spans.len(), false);
+        self.impact_joints.clear();
+        self.impact_joints.extend(
+            self.island_joints
+                .iter()
+                .map(|j| JointConstraint { motor: None, ..*j }),
+        );
+        if 2 * self.impact_joints.len() + 3 > self.dense_row_limit {
+            return;
+        }
+        self.impact_impulses
+            .resize(self.island_contacts.len(), (0.0, 0.0));
+        let impact_targets = VelocityTargets {
+            close_joint_gaps: false,
+            ..*targets
+        };
+        let mut budget = IMPACT_SOLVES_PER_PAIR * self.pair_spans.len();
+        'sweeps: loop {
+            let mut any = false;
+            for p in 0..self.pair_spans.len() {
+                let (start, end) = self.pair_spans[p];
+                self.impact_contacts.clear();
+                for &(index, c) in &self.island_contacts[start..end] {
+                    let a = &bodies[c.body_a as usize];
+                    let b = &bodies[c.body_b as usize];
+                    let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
+                    // What the step's forces add along the normal: reflected never, but
+                    // counted in whether the pair meets this step.
+                    let forces = c.normal_velocity - c.approach_velocity;
+                    let (approach_velocity, normal_velocity) = match kick {
+                        Kick::Applied => (now - forces, now),
+                        Kick::Pending => (now, now + forces),
+                    };
+                    self.impact_contacts.push((
+                        index,
+                        Contact {
+                            approach_velocity,
+                            normal_velocity,
+                            ..c
+                        },
+                    ));
+                }
+                if !self
+                    .impact_contacts
+                    .iter()
+                    .any(|(_, c)| c.bounces(dt, bounce_below))
+                {
+                    continue;
+                }
+                if budget == 0 {
+                    break 'sweeps;
+                }
+                budget -= 1;
+                any = true;
+
+                self.bounced[p] = true;
+                velocity_rows(
+                    &self.impact_contacts,
+                    &self.impact_joints,
+                    bodies,
+                    &impact_targets,
+                    &mut self.rows,
+                );
+                // The pins hold their velocities as they are: the pass moves nothing but
+                // the impact through them.
+                for row in self.rows.iter_mut() {
+                    if matches!(row.kind, RowKind::JointX(_) | RowKind::JointY(_)) {
+                        row.b = 0.0;
+                    }
+                }
+                self.guess.clear();
+                self.solve_rows_dense(bodies);
+                for (row, &x) in self.rows.iter().zip(&self.x) {
+                    row.apply(bodies, x);
+                    let local = |i: u32| {
+                        self.island_contacts[start..end]
+                            .iter()
+                            .position(|&(index, _)| index == i)
+                            .map(|k| start + k)
+                    };
+                    match row.kind {
+                        RowKind::ContactNormal(i) => {
+                            if let Some(k) = local(i) {
+                                self.impact_impulses[k].0 += x;
+                            }
+                        }
+                        RowKind::ContactTangent(i) | RowKind::SharedTangent(i, _) => {
+                            if let Some(k) = local(i) {
+                                self.impact_impulses[k].1 += x;
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+        for (p, &(start, end)) in self.pair_spans.iter().enumerate() {
+            if self.bounced[p] {
+                for (_, c) in &mut self.island_contacts[start..end] {
+                    c.approach_velocity = 0.0;
+                }
+            }
+        }
+    }
+
     fn solve_coupled(&mut self, bodies: &mut [SolverBody], targets: &VelocityTargets) {
         velocity_rows(
             &self.island_contacts,
@@ -514,5 +744,21 @@ impl SimultaneousSolver {
                 RowKind::JointX(_) | RowKind::JointY(_) => {}
             }
         }
+        // What the impact pass gave a contact is part of its impulse this step.
+        for (&(i, _), &(normal, tangent)) in self.island_contacts.iter().zip(&self.impact_impulses)
+        {
+            contacts[i as usize].normal_impulse += normal;
+            contacts[i as usize].tangent_impulse += tangent;
+        }
     }
+}
+
+/// Whether contact `c` bounces this step between two moving bodies: an impact that may
+/// pass on through the bodies at rest in contact with them.
+fn passes_on(c: &Contact, bodies: &[SolverBody], targets: &VelocityTargets) -> bool {
+    let moves = |i: u32| {
+        let b = &bodies[i as usize];
+        b.inv_mass > 0.0 || b.inv_inertia > 0.0
+    };
+    c.bounces(targets.dt, targets.bounce_below) && moves(c.body_a) && moves(c.body_b)
 }

@@ -206,6 +206,7 @@ impl World {
                     FrictionModel::Coupled
                 };
                 s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
+                s.simultaneous.propagate_impacts = self.settings.propagate_impacts;
                 s.simultaneous.solve(
                     model,
                     &mut self.contacts,

@@ -28,6 +28,7 @@ use crate::solver::joint::{Joint, JointBlockSolver, JointConstraint, JointHandle
 use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
 use crate::solver::soft::{SoftSettings, SoftStepSolver};
+use crate::solver::system::VelocityTargets;
 use crate::solver::{ContactSolver, SolverBody};
 use crate::stage_clock::{self, Stage};
 
@@ -678,6 +679,10 @@ impl World {
             _ => (Vec2::zeros(), 0.0),
         }));
         s.accelerations.push((Vec2::zeros(), 0.0));
+        if self.settings.propagate_impacts {
+            self.propagate_impacts_before_soft_step(dt);
+        }
+        let s = &mut self.scratch;
         s.soft.step(
             &SoftSettings {
                 substeps: self.settings.soft_substeps.max(1),
@@ -692,6 +697,34 @@ impl World {
             restitution_threshold(self.gravity, dt),
         );
         self.scatter_solver_bodies();
+    }
+
+    /// The impact pass (`SimultaneousSolver::propagate_all_impacts`) before the soft step,
+    /// which then bounces only what the pass left.
+    fn propagate_impacts_before_soft_step(&mut self, dt: f64) {
+        let s = &mut self.scratch;
+        // The soft step's contacts carry the velocities of the step's start; whether
+        // a pair meets this step also takes the step's forces (as `exact`'s do).
+        for c in self.contacts.iter_mut() {
+            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            let kick = (s.accelerations[a].0 - s.accelerations[b].0).dot(&c.normal) * dt;
+            c.normal_velocity = c.approach_velocity + kick;
+        }
+        s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
+        s.simultaneous.propagate_all_impacts(
+            &mut self.contacts,
+            &s.joint_constraints,
+            &mut s.solver_bodies,
+            &VelocityTargets {
+                dt,
+                bounce_below: restitution_threshold(self.gravity, dt),
+                friction: true,
+                close_joint_gaps: false,
+            },
+        );
+        for c in self.contacts.iter_mut() {
+            c.normal_velocity = c.approach_velocity;
+        }
     }
 
     /// How each island was solved in the last step: by which method (see

@@ -38,6 +38,11 @@ pub struct StepSettings {
     /// substeps, against the sway that one fixed order builds in a pile (see
     /// `solver::soft::SweepOrder`).
     pub soft_alternating_sweeps: bool,
+    /// Whether an impact between moving bodies passes on through the bodies at rest in
+    /// contact with them, pair by pair (a Newton's cradle sends out one ball), under
+    /// `exact`, `soft` and `auto`; otherwise each island's contacts bounce together in one
+    /// LCP, as in the thesis (the cradle moves off as a block).
+    pub propagate_impacts: bool,
 }
 
 impl Default for StepSettings {
@@ -53,6 +58,7 @@ impl Default for StepSettings {
             soft_substeps: 4,
             reuse_manifolds: true,
             soft_alternating_sweeps: true,
+            propagate_impacts: true,
         }
     }
 }
