@@ -1,6 +1,7 @@
 //! The `robosim` command line: the editor by default, `run` and `check` headless.
 //! Every failure is one line on stderr and exit code 2.
 
+use crate::animation;
 use crate::db::{Database, Problem, one_line};
 use crate::sim::Simulation;
 use crate::sim::trace::Record;
@@ -73,6 +74,13 @@ pub struct RunArgs {
     /// Write the trace to this file instead of stdout.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also write the run as an animated GIF (640 × 480, the whole run in view) to this
+    /// file; with --gif and no --out, no trace is written.
+    #[arg(long, value_name = "FILE")]
+    pub gif: Option<PathBuf>,
+    /// Steps between the GIF's frames (default: a frame every 1/25 s of simulated time).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..))]
+    pub gif_every: Option<u64>,
 }
 
 /// A step in seconds: a finite number > 0 (its range is the scene's to check).
@@ -295,8 +303,11 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         };
         return Err(Failure(format!("{first}{more}")));
     }
-    if let Some(out) = &args.out {
+    for out in args.out.iter().chain(&args.gif) {
         refuse_to_overwrite_the_database(out, &args.db)?;
+    }
+    if let Some(gif) = &args.gif {
+        require_folder_of(gif)?;
     }
     let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
         .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
@@ -310,6 +321,8 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             std::fs::File::create(path)
                 .map_err(|e| Failure(format!("{}: cannot write: {e}", path.display())))?,
         ),
+        // A GIF alone was asked for.
+        None if args.gif.is_some() => Box::new(std::io::sink()),
         None if standard_output_was_closed() => {
             return Err(Failure(
                 "standard output is closed: nowhere to write the trace (use --out FILE)".into(),
@@ -349,6 +362,16 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     if let Err(e) = emit(&sim, &mut out) {
         return written(e).outcome();
     }
+    let mut movie = args.gif.as_ref().map(|_| {
+        let every = args
+            .gif_every
+            .unwrap_or_else(|| animation::steps_per_frame(sim.dt))
+            .max(animation::every_for_at_most_max_frames(args.steps));
+        (animation::Recording::default(), every)
+    });
+    if let Some((recording, _)) = movie.as_mut() {
+        recording.capture(&sim);
+    }
     for _ in 0..args.steps {
         let stepped = sim.try_step();
         let step = sim.step_count();
@@ -364,13 +387,38 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         {
             return written(e).outcome();
         }
+        if let Some((recording, every)) = movie.as_mut()
+            && step.is_multiple_of(*every)
+        {
+            recording.capture(&sim);
+        }
         progress.inc(1);
     }
     progress.finish_and_clear();
     if let Err(e) = out.flush() {
         return written(e).outcome();
     }
+    if let (Some((recording, _)), Some(path)) = (movie, &args.gif) {
+        let gif = recording
+            .to_gif(animation::WIDTH, animation::HEIGHT)
+            .map_err(Failure)?;
+        animation::write_atomically(path, &gif).map_err(Failure)?;
+    }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses a file whose folder does not exist, before the run rather than after it.
+fn require_folder_of(file: &Path) -> Result<(), Failure> {
+    match file.parent() {
+        Some(folder) if !folder.as_os_str().is_empty() && !folder.is_dir() => {
+            Err(Failure(format!(
+                "cannot write {}: no folder {}",
+                file.display(),
+                folder.display()
+            )))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Refuses a trace file that is one of the database's own files (or the folder).

@@ -6,6 +6,7 @@
 
 pub use pe;
 
+pub mod animation;
 #[cfg(feature = "app")]
 pub mod app;
 pub mod cli;

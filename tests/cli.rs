@@ -267,3 +267,93 @@ fn without_the_app_feature_the_editor_is_refused_clearly() {
     let out = robosim().args(["check", "--db", "data"]).output().unwrap();
     assert!(out.status.success());
 }
+
+/// The frames of a GIF as RGBA pixels, with the picture's size.
+fn gif_frames(path: &std::path::Path) -> (u16, u16, Vec<Vec<u8>>) {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(path).unwrap())
+        .unwrap();
+    let (w, h) = (decoder.width(), decoder.height());
+    let mut frames = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!((frame.width, frame.height), (w, h), "whole frames");
+        frames.push(frame.buffer.to_vec());
+    }
+    (w, h, frames)
+}
+
+#[test]
+fn gif_writes_the_run_as_an_animation_without_a_trace() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stack.gif");
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "60",
+        "--gif-every",
+        "6",
+        "--gif",
+        path.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.stdout.is_empty(), "no --out: the GIF alone");
+    // Steps 0, 6, …, 60: 11 frames of 640 × 480.
+    let (w, h, frames) = gif_frames(&path);
+    assert_eq!((w, h, frames.len()), (640, 480, 11));
+    // The ball falls: the first and last frames differ, while the stack stands.
+    assert_ne!(frames[0], frames[10]);
+    // The default: a frame every 1/25 s, two steps of 1/60 s.
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "30",
+        "--gif",
+        path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert_eq!(gif_frames(&path).2.len(), 16);
+}
+
+#[test]
+fn a_gif_that_cannot_be_written_is_one_line_and_exit_2_and_leaves_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no such folder").join("x.gif");
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "5",
+        "--gif",
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("cannot write") && err.contains("x.gif"),
+        "{err}"
+    );
+    // A folder, not a file, where the GIF should go: refused after the run, nothing left.
+    let folder = dir.path().join("taken.gif");
+    std::fs::create_dir(&folder).unwrap();
+    let out = run(&[
+        "--scene",
+        "stack of boxes",
+        "--steps",
+        "5",
+        "--gif",
+        folder.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "no temporary file left behind: {left:?}");
+}

@@ -941,5 +941,7 @@ fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() 
 // More of the editor's tests, a file per feature.
 #[path = "editor/drawing.rs"]
 mod drawing;
+#[path = "editor/export.rs"]
+mod export;
 #[path = "editor/selection.rs"]
 mod selection;

@@ -51,6 +51,8 @@ pub enum Command {
     Quit,
     ExportPlots,
     ExportView(ImageFormat),
+    /// Record the run shown, from step 0 to the step shown (or 10 s), as an animated GIF.
+    ExportGif,
     /// Take up (or forget) the unsaved work an earlier session kept for `folder`.
     Restore(Option<PathBuf>, Model),
     DiscardKeptWork(Option<PathBuf>),

@@ -5,6 +5,7 @@ use super::command::{AfterSave, ImageFormat};
 use super::dialogs::Dialog;
 use super::files::Answer;
 use super::{Command, RoboSimApp, Selection, document, plots};
+use crate::animation;
 use crate::db::{Overwrite, SaveError};
 use std::path::{Path, PathBuf};
 
@@ -29,6 +30,7 @@ impl RoboSimApp {
             Command::Quit => self.leave_for(AfterSave::Quit, ctx),
             Command::ExportPlots => self.export_plots(),
             Command::ExportView(format) => self.export_view(format, ctx),
+            Command::ExportGif => self.export_gif(ctx),
             Command::Restore(folder, model) => self.restore(folder, model, now),
             Command::DiscardKeptWork(folder) => self.doc.discard_kept_work(folder.as_deref()),
             _ => {}
@@ -271,10 +273,11 @@ impl RoboSimApp {
             ImageFormat::Png => {
                 // The integration reads the pixels after this frame and calls back.
                 let (rect, scale) = (self.view.rect, ctx.pixels_per_point());
-                let written = self.screenshot_written.clone();
+                let written = self.export_news.clone();
                 let repaint = ctx.clone();
                 ctx.request_screenshot(move |image| {
-                    let outcome = write_png(&image.region(&rect, Some(scale)), &path);
+                    let outcome = write_png(&image.region(&rect, Some(scale)), &path)
+                        .map(|p| format!("view written to {}", p.display()));
                     if let Ok(mut slot) = written.lock() {
                         *slot = Some(outcome);
                     }
@@ -284,18 +287,56 @@ impl RoboSimApp {
         }
     }
 
-    /// Reports a PNG export the integration finished since the last frame.
-    pub(super) fn screenshot_news(&mut self) {
+    /// Reports an export another thread finished since the last frame.
+    pub(super) fn export_news(&mut self) {
         let outcome = self
-            .screenshot_written
+            .export_news
             .lock()
             .ok()
             .and_then(|mut slot| slot.take());
         match outcome {
-            Some(Ok(path)) => self.inform(format!("view written to {}", path.display())),
+            Some(Ok(news)) => self.inform(news),
             Some(Err(why)) => self.complain(why),
             None => {}
         }
+    }
+
+    /// Records the run shown as an animated GIF on a thread of its own (a long run takes
+    /// seconds to simulate and encode): from step 0 to the step shown, or the first 10 s
+    /// when it is at step 0. Mouse pulls and the world's edge are the window's alone: the
+    /// recording is the scene's own physics.
+    fn export_gif(&mut self, ctx: &egui::Context) {
+        let Some(mut sim) = self.runner.sim().cloned() else {
+            return self.complain("nothing to record: no scene is shown".into());
+        };
+        let steps = match sim.step_count() {
+            0 => (10.0 / sim.dt).round() as u64,
+            shown => shown,
+        };
+        sim.reset();
+        let name = self.export_name("run", "gif");
+        let Some(path) = self.export_path("Export the run as GIF", name, "gif") else {
+            return;
+        };
+        self.inform(format!("recording {steps} steps as a GIF…"));
+        let news = self.export_news.clone();
+        let repaint = ctx.clone();
+        std::thread::spawn(move || {
+            let every = animation::steps_per_frame(sim.dt);
+            let outcome = animation::record(&mut sim, steps, every).and_then(|recording| {
+                let gif = recording.to_gif(animation::WIDTH, animation::HEIGHT)?;
+                animation::write_atomically(&path, &gif)?;
+                Ok(format!(
+                    "run written to {} ({} frames)",
+                    path.display(),
+                    recording.frame_count()
+                ))
+            });
+            if let Ok(mut slot) = news.lock() {
+                *slot = Some(outcome);
+            }
+            repaint.request_repaint();
+        });
     }
 }
 

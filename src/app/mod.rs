@@ -110,9 +110,9 @@ pub struct RoboSimApp {
     copied: Option<placements::Clipboard>,
     /// The window may close: the user answered the unsaved-changes question.
     close_confirmed: bool,
-    /// A PNG export of the view the integration finished (on its own thread): where, or
-    /// why not.
-    screenshot_written: std::sync::Arc<std::sync::Mutex<Option<Result<PathBuf, String>>>>,
+    /// What an export finished on another thread (a PNG of the view, a GIF of the run)
+    /// has to say: what it wrote, or why not.
+    export_news: std::sync::Arc<std::sync::Mutex<Option<Result<String, String>>>>,
 }
 
 impl RoboSimApp {
@@ -137,7 +137,7 @@ impl RoboSimApp {
             files: Box::new(files::SystemDialogs),
             copied: None,
             close_confirmed: false,
-            screenshot_written: Default::default(),
+            export_news: Default::default(),
         };
         app.toolbar.path_input = dir
             .as_ref()
@@ -327,6 +327,7 @@ impl RoboSimApp {
             | C::Quit
             | C::ExportPlots
             | C::ExportView(_)
+            | C::ExportGif
             | C::Restore(..)
             | C::DiscardKeptWork(_) => self.apply_file_command(command, ctx, now),
             C::SetRunning(on) => self.runner.running = on,
@@ -629,7 +630,7 @@ impl eframe::App for RoboSimApp {
         let note = self.runner.advance(frame_seconds, self.followed);
         self.run_note(note);
         self.autosave_tick(&ctx, now);
-        self.screenshot_news();
+        self.export_news();
         let mut commands = self.panels(ui);
         commands.extend(self.windows(&ctx));
         for command in commands {

@@ -182,6 +182,15 @@ impl Toolbar {
         ) {
             out.push(Command::ExportView(ImageFormat::Png));
         }
+        if entry(
+            ui,
+            true,
+            "Export run as GIF…",
+            None,
+            "The run from step 0 to the step shown (the first 10 s at step 0) as an animated GIF, 640 × 480, to share",
+        ) {
+            out.push(Command::ExportGif);
+        }
         ui.separator();
         if entry(
             ui,
