@@ -359,3 +359,41 @@ fn a_robot_placed_so_far_that_its_bodies_pass_the_limits_is_refused_by_check_and
         "the simulation said {message:?}"
     );
 }
+
+/// The default database's Newton's cradle, as the app runs it (its default solver): the
+/// first pendulum, released from 30°, stops at the bottom and the last swings out to the
+/// whole 30° (within 10%); the three between stay under a tenth of it.
+#[test]
+fn the_default_cradle_sends_out_one_pendulum() {
+    let model = model();
+    let mut sim = Simulation::new(&model, "newton's cradle", None, None).unwrap();
+    let angles = |sim: &Simulation| -> Vec<f64> {
+        Record::of(sim)
+            .bodies
+            .iter()
+            .filter(|b| b.id.contains("/p"))
+            .map(|b| b.angle)
+            .collect()
+    };
+    let release = angles(&sim)[0];
+    assert!((release - 30f64.to_radians()).abs() < 1e-12, "{release}");
+    let mut steps = 0;
+    while angles(&sim)[0] > 1e-3 {
+        sim.step();
+        steps += 1;
+        assert!(steps < 2000, "the first pendulum never reached the bottom");
+    }
+    // The second after the impact (240 steps of 1/240 s): the last one's swing out
+    // takes about a quarter period, 0.9 s.
+    let mut widest = vec![0.0_f64; 5];
+    for _ in 0..240 {
+        sim.step();
+        for (w, a) in widest.iter_mut().zip(angles(&sim)) {
+            *w = w.max(a.abs() / release);
+        }
+    }
+    assert!(
+        widest[4] > 0.9 && widest[..4].iter().all(|&w| w < 0.1),
+        "each pendulum's widest swing over the release angle: {widest:.3?}"
+    );
+}
