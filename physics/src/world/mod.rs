@@ -702,6 +702,10 @@ impl World {
     /// The impact pass (`SimultaneousSolver::propagate_all_impacts`) before the soft step,
     /// which then bounces only what the pass left.
     fn propagate_impacts_before_soft_step(&mut self, dt: f64) {
+        // Most scenes bounce nothing: a pile of cor 0 pays one look at its contacts.
+        if self.contacts.iter().all(|c| c.restitution == 0.0) {
+            return;
+        }
         let s = &mut self.scratch;
         // The soft step's contacts carry the velocities of the step's start; whether
         // a pair meets this step also takes the step's forces (as `exact`'s do).
