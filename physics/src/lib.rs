@@ -58,5 +58,8 @@ pub use crate::{
         simultaneous::{IslandMethod, IslandReport},
         soft::lane_path_name,
     },
-    world::{FALL_PER_STEP, Integrator, JointDef, JointError, StepError, StepSettings, World},
+    world::{
+        FALL_PER_STEP, JointDef, JointError, StepError, World,
+        settings::{Integrator, StepSettings},
+    },
 };

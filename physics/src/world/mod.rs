@@ -8,11 +8,11 @@ mod contacts;
 mod continuous;
 mod impulses;
 mod integrate;
-mod settings;
+pub(crate) mod settings;
 mod sleeping;
 mod solver_bodies;
 
-pub use settings::{Integrator, StepSettings};
+use settings::{Integrator, StepSettings};
 
 use auto::{IslandNeeds, LastMarking};
 use candidates::NeighbourScratch;
