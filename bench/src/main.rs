@@ -6,12 +6,14 @@
 //! listing each that sinks with `list`; with `stages <scene>` (feature `stages`), pe's
 //! stages beside rapier2d's and Box2D v3's own profiles of the same scene; with `samples
 //! [name,...]`, Box2D v3's samples in every engine (`sample_runs.rs`), printing their
-//! tables.
+//! tables; with `cradle`, Newton's cradle in every engine (`cradle.rs`) to
+//! docs/bench/cradle.md and its plot.
 //!
-//! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws | -- samples]`
-//! inside bench/.
+//! Run with `cargo run --release [-- sweep | -- pe smash soft | -- throws | -- samples |
+//! -- cradle]` inside bench/.
 
 mod box2d_scenes;
+mod cradle;
 mod harness;
 mod machine;
 mod pe_scenes;
@@ -145,6 +147,21 @@ fn main() {
             PeerBuild::CURRENT.box2d(),
         );
         write_doc(docs, "sweep.md", &md);
+        return;
+    }
+    if std::env::args().nth(1).as_deref() == Some("cradle") {
+        let mut md = cradle::run(docs);
+        let _ = writeln!(
+            md,
+            "Machine: {}; {}; {code}; rapier2d {}: {}; Box2D v3 through boxdd {}: {}.",
+            machine(),
+            today(),
+            rapier_version(),
+            PeerBuild::CURRENT.rapier2d(),
+            locked_version("boxdd"),
+            PeerBuild::CURRENT.box2d(),
+        );
+        write_doc(docs, "cradle.md", &md);
         return;
     }
     if std::env::args().nth(1).as_deref() == Some("pe") {
