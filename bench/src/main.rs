@@ -208,6 +208,27 @@ fn main() {
         println!("{md}");
         return;
     }
+    let rows = engine_rows();
+    let piles = pile_rows();
+    let narrow = narrow_phase_rows();
+    let robot_rows = robots::run();
+    let throw_rows = throws::run(throws::THROWS, throws::SEED, false);
+    let sample_rows = sample_runs::run(&[]);
+    let mut report = report(
+        &rows,
+        &piles,
+        &narrow,
+        &robot_rows,
+        &throw_rows,
+        started.elapsed(),
+        (&load, &code),
+    );
+    sample_runs::write(&mut report, &sample_rows);
+    write_doc(docs, "results.md", &report);
+}
+
+/// The main run's scenes with known answers, each in every engine (`run_row`).
+fn engine_rows() -> Vec<Row> {
     let mut rows = Vec::new();
     for spec in &PYRAMIDS {
         rows.push(run_row(
@@ -255,22 +276,7 @@ fn main() {
         rapier_scenes::smash,
         box2d_scenes::smash,
     ));
-    let piles = pile_rows();
-    let narrow = narrow_phase_rows();
-    let robot_rows = robots::run();
-    let throw_rows = throws::run(throws::THROWS, throws::SEED, false);
-    let sample_rows = sample_runs::run(&[]);
-    let mut report = report(
-        &rows,
-        &piles,
-        &narrow,
-        &robot_rows,
-        &throw_rows,
-        started.elapsed(),
-        (&load, &code),
-    );
-    sample_runs::write(&mut report, &sample_rows);
-    write_doc(docs, "results.md", &report);
+    rows
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
