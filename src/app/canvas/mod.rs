@@ -182,7 +182,8 @@ impl CanvasView {
         self.rubber_band(ui, &response, scene, &mut commands);
         self.draw_gesture(ui, &response, scene, &mut commands);
         // A click this frame shows at once what it selected; the app's selection next frame.
-        let selected: Vec<usize> = if followed == scene.followed {
+        // While running, only the followed body: the one the plots show.
+        let selected: Vec<usize> = if followed == scene.followed && scene.editing {
             scene.picked.to_vec()
         } else {
             followed.into_iter().collect()
@@ -270,7 +271,7 @@ impl CanvasView {
             && let Some(p) = pressed_screen
         {
             let on_handle = self
-                .handle(sim, scene.followed)
+                .handle(sim, scene.followed, scene.picked)
                 .is_some_and(|h| h.distance(p) <= HANDLE_RADIUS + 4.0);
             ui.ctx().data_mut(|d| d.insert_temp(turning_id, on_handle));
         }
@@ -439,10 +440,15 @@ impl CanvasView {
     }
 
     /// Where the rotate handle of body `i` is on screen: above its outline.
-    fn handle(&self, sim: &Simulation, i: Option<usize>) -> Option<egui::Pos2> {
+    /// With others selected, it stands above them all, clear of the group it turns.
+    fn handle(&self, sim: &Simulation, i: Option<usize>, picked: &[usize]) -> Option<egui::Pos2> {
         let body = sim.bodies.get(i?).and_then(|b| sim.world.body(b.handle))?;
-        let top = body
-            .world_vertices()
+        let group = picked
+            .iter()
+            .filter_map(|&k| sim.world.body(sim.bodies.get(k)?.handle));
+        let top = std::iter::once(body)
+            .chain(group)
+            .flat_map(|b| b.world_vertices().collect::<Vec<_>>())
             .map(|v| self.camera.to_screen(self.rect, v).y)
             .fold(f32::INFINITY, f32::min);
         let origin = self.camera.to_screen(self.rect, body.origin());
@@ -459,7 +465,7 @@ impl CanvasView {
         let to_screen = |p: Vec2| self.camera.to_screen(self.rect, p);
         if scene.editing
             && self.tool == Tool::Select
-            && let Some(h) = self.handle(scene.sim, followed)
+            && let Some(h) = self.handle(scene.sim, followed, scene.picked)
             && let Some(body) = followed
                 .and_then(|i| scene.sim.bodies.get(i))
                 .and_then(|b| scene.sim.world.body(b.handle))
