@@ -151,16 +151,7 @@ fn main() {
     }
     if std::env::args().nth(1).as_deref() == Some("cradle") {
         let mut md = cradle::run(docs);
-        let _ = writeln!(
-            md,
-            "Machine: {}; {}; {code}; rapier2d {}: {}; Box2D v3 through boxdd {}: {}.",
-            machine(),
-            today(),
-            rapier_version(),
-            PeerBuild::CURRENT.rapier2d(),
-            locked_version("boxdd"),
-            PeerBuild::CURRENT.box2d(),
-        );
+        let _ = writeln!(md, "{}", run_line(None, &code));
         write_doc(docs, "cradle.md", &md);
         return;
     }
@@ -182,16 +173,7 @@ fn main() {
             .flat_map(|a| a.split(',').map(String::from).collect::<Vec<_>>())
             .collect();
         let rows = sample_runs::run(&names);
-        let mut md = format!(
-            "Machine: {}; load average at start: {load}; {}; {code}; rapier2d {}: {}; \
-             Box2D v3 through boxdd {}: {}.\n",
-            machine(),
-            today(),
-            rapier_version(),
-            PeerBuild::CURRENT.rapier2d(),
-            locked_version("boxdd"),
-            PeerBuild::CURRENT.box2d(),
-        );
+        let mut md = format!("{}\n", run_line(Some(&load), &code));
         sample_runs::write(&mut md, &rows);
         println!("{md}");
         return;
@@ -277,6 +259,21 @@ fn engine_rows() -> Vec<Row> {
         box2d_scenes::smash,
     ));
     rows
+}
+
+/// A report's closing line: the machine, the load at the start (if given), the date, the
+/// code measured and the peers' versions and builds.
+fn run_line(load: Option<&str>, code: &str) -> String {
+    let load = load.map_or(String::new(), |l| format!("load average at start: {l}; "));
+    format!(
+        "Machine: {}; {load}{}; {code}; rapier2d {}: {}; Box2D v3 through boxdd {}: {}.",
+        machine(),
+        today(),
+        rapier_version(),
+        PeerBuild::CURRENT.rapier2d(),
+        locked_version("boxdd"),
+        PeerBuild::CURRENT.box2d(),
+    )
 }
 
 /// Prints a report and writes it to `docs/<file>`, exiting with an error if it cannot.
