@@ -4,7 +4,7 @@
 //! scene's body, a whole robot in a scene, a robot's body), each once.
 
 use super::{Copied, RoboSimApp, Selection, document::unique, placing};
-use crate::model::{Model, Scene};
+use crate::model::{JointDef, Model, Robot, Scene, same_name};
 use crate::sim::PlacedBy;
 use pe::{Aabb, Vec2};
 
@@ -18,11 +18,13 @@ pub(super) enum Owner {
 }
 
 /// Placements copied with Ctrl+C, and the world box around their bodies when copied: a
-/// paste moves the whole group by one offset, so it keeps its shape.
+/// paste moves the whole group by one offset, so it keeps its shape. Copied robot bodies
+/// bring the joints between them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Clipboard {
     pub items: Vec<Copied>,
     pub bounds: Aabb,
+    pub joints: Vec<JointDef>,
 }
 
 impl Copied {
@@ -226,7 +228,28 @@ impl RoboSimApp {
                 .filter_map(|&i| sim.world.body(sim.bodies.get(i)?.handle))
                 .flat_map(|b| b.world_vertices().collect::<Vec<_>>()),
         )?;
-        (!items.is_empty()).then_some(Clipboard { items, bounds })
+        let joints = match (&self.selection, items.first()) {
+            (Some(Selection::Robot(n)), Some(Copied::RobotBody(_))) => {
+                let copied = |alias: &str| {
+                    items.iter().any(
+                        |c| matches!(c, Copied::RobotBody(b) if same_name(&b.placement.alias, alias)),
+                    )
+                };
+                model.robot(n).map_or(Vec::new(), |r| {
+                    r.joints
+                        .iter()
+                        .filter(|j| copied(&j.body_a) && copied(&j.body_b))
+                        .cloned()
+                        .collect()
+                })
+            }
+            _ => Vec::new(),
+        };
+        (!items.is_empty()).then_some(Clipboard {
+            items,
+            bounds,
+            joints,
+        })
     }
 
     /// Removes the selected placements at step 0 (a robot body with its joints) as one
@@ -268,23 +291,9 @@ impl RoboSimApp {
                     .scene_mut(&scene)
                     .map(|s| put_in_scene(s, clip.items, delta))
             }
-            Some(Selection::Robot(robot)) if robot_bodies == clip.items.len() => {
-                draft.robot_mut(&robot).map(|r| {
-                    let first = r.bodies.len();
-                    for item in clip.items {
-                        let Copied::RobotBody(mut body) = item else {
-                            continue;
-                        };
-                        let aliases: Vec<String> =
-                            r.bodies.iter().map(|b| b.placement.alias.clone()).collect();
-                        body.placement.alias = unique(&aliases, &body.placement.alias);
-                        body.placement.x += 20.0;
-                        body.placement.y += 20.0;
-                        r.bodies.push(body);
-                    }
-                    (first..r.bodies.len()).map(Owner::RobotBody).collect()
-                })
-            }
+            Some(Selection::Robot(robot)) if robot_bodies == clip.items.len() => draft
+                .robot_mut(&robot)
+                .map(|r| paste_into_robot(r, clip.items, clip.joints)),
             _ => {
                 return self.complain(
                     "paste a scene's robots and bodies into a scene, a robot's bodies into a robot"
@@ -298,6 +307,43 @@ impl RoboSimApp {
         self.commit(draft, key, now);
         self.pick_owners(&pasted);
     }
+}
+
+/// Adds `items` (robot bodies) to `robot` beside where they were copied from, each under
+/// an alias not yet taken, with `joints` between them renamed to match; returns where
+/// they went. A joint's anchor is relative to its bodyA, which moves with it.
+fn paste_into_robot(robot: &mut Robot, items: Vec<Copied>, joints: Vec<JointDef>) -> Vec<Owner> {
+    let first = robot.bodies.len();
+    let mut renamed: Vec<(String, String)> = Vec::new();
+    for item in items {
+        let Copied::RobotBody(mut body) = item else {
+            continue;
+        };
+        let aliases: Vec<String> = robot
+            .bodies
+            .iter()
+            .map(|b| b.placement.alias.clone())
+            .collect();
+        let alias = unique(&aliases, &body.placement.alias);
+        renamed.push((body.placement.alias.clone(), alias.clone()));
+        body.placement.alias = alias;
+        body.placement.x += 20.0;
+        body.placement.y += 20.0;
+        robot.bodies.push(body);
+    }
+    let new_alias = |old: &str| {
+        renamed
+            .iter()
+            .find(|(o, _)| same_name(o, old))
+            .map(|(_, n)| n.clone())
+    };
+    for mut joint in joints {
+        if let (Some(a), Some(b)) = (new_alias(&joint.body_a), new_alias(&joint.body_b)) {
+            (joint.body_a, joint.body_b) = (a, b);
+            robot.joints.push(joint);
+        }
+    }
+    (first..robot.bodies.len()).map(Owner::RobotBody).collect()
 }
 
 /// Adds `items` (scene robots and scene bodies) to `scene` moved by `delta`, a body under

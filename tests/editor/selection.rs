@@ -213,3 +213,41 @@ fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
     h.run_steps(2);
     assert_eq!(stack(&h).bodies.len(), count);
 }
+
+#[test]
+fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label_contains("housenka ·").click();
+    h.run_steps(2);
+    let before = h.state().model().clone();
+    // The housenka's three 40 × 20 bodies at x = −33, 0, 33, pinned h_0–h_1 and h_1–h_2.
+    band(&mut h, (-70.0, -30.0), (70.0, 30.0), Modifiers::NONE);
+    assert_eq!(h.state().picked().len(), 3);
+    h.key_press_modifiers(Modifiers::COMMAND, Key::D);
+    h.run_steps(2);
+    let robot = h.state().model().robot("housenka").unwrap().clone();
+    let aliases: Vec<&str> = robot
+        .bodies
+        .iter()
+        .map(|b| b.placement.alias.as_str())
+        .collect();
+    assert_eq!(aliases, ["h_0", "h_1", "h_2", "h_0 2", "h_1 2", "h_2 2"]);
+    let pins: Vec<(&str, &str)> = robot
+        .joints
+        .iter()
+        .map(|j| (j.body_a.as_str(), j.body_b.as_str()))
+        .collect();
+    assert_eq!(
+        pins,
+        [
+            ("h_0", "h_1"),
+            ("h_1", "h_2"),
+            ("h_0 2", "h_1 2"),
+            ("h_1 2", "h_2 2")
+        ]
+    );
+    assert_eq!(robot.joints[2].anchor_ax, robot.joints[0].anchor_ax);
+    undo(&mut h);
+    assert_eq!(*h.state().model(), before);
+}
