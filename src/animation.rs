@@ -33,8 +33,6 @@ struct Outline {
 #[derive(Debug, Clone, Default)]
 pub struct Recording {
     frames: Vec<(f64, Vec<Outline>)>,
-    /// The box around every body at step 0, which the camera keeps in view.
-    start: Option<Aabb>,
 }
 
 /// The fewest steps between frames that keep a run of `steps` steps within `MAX_FRAMES`
@@ -68,9 +66,6 @@ impl Recording {
                 })
             })
             .collect();
-        if self.start.is_none() {
-            self.start = bounds(outlines.iter().flat_map(|o| o.points.iter().copied()));
-        }
         self.frames.push((sim.time(), outlines));
     }
 
@@ -78,37 +73,55 @@ impl Recording {
         self.frames.len()
     }
 
-    /// The world box the camera frames: every moving body over the whole run, kept to
-    /// the neighbourhood of the scene at step 0 (a body that falls off the world would
-    /// shrink the rest to dots), or every body when nothing moves.
-    fn view(&self) -> Aabb {
-        let moving = bounds(self.frames.iter().flat_map(|(_, outlines)| {
-            outlines
-                .iter()
-                .filter(|o| o.moving)
-                .flat_map(|o| o.points.iter().copied())
-        }));
-        let start = self.start.unwrap_or(Aabb {
-            min: Vec2::repeat(-1.0),
-            max: Vec2::repeat(1.0),
-        });
-        let Some(moving) = moving else {
-            return start;
+    /// The world box each frame shows. The camera follows the moving bodies as the
+    /// editor's Follow does: each frame centred on their box, eased so that it does not
+    /// shake with them, at one zoom for the whole run that fits the widest of those boxes
+    /// with room to move (a body that flies off stretches it at most tenfold). With
+    /// nothing moving, every body at step 0.
+    fn views(&self) -> Vec<Aabb> {
+        let moving: Vec<Option<Aabb>> = self
+            .frames
+            .iter()
+            .map(|(_, outlines)| {
+                bounds(
+                    outlines
+                        .iter()
+                        .filter(|o| o.moving)
+                        .flat_map(|o| o.points.iter().copied()),
+                )
+            })
+            .collect();
+        let all_at_start = self
+            .frames
+            .first()
+            .and_then(|(_, o)| bounds(o.iter().flat_map(|o| o.points.iter().copied())))
+            .unwrap_or(Aabb {
+                min: Vec2::repeat(-1.0),
+                max: Vec2::repeat(1.0),
+            });
+        let Some(first) = moving.first().copied().flatten() else {
+            return vec![all_at_start; self.frames.len()];
         };
-        let reach = (start.max - start.min).norm().max(1.0);
-        let near = Aabb {
-            min: start.min - Vec2::repeat(reach),
-            max: start.max + Vec2::repeat(reach),
-        };
-        let clipped = Aabb {
-            min: moving.min.sup(&near.min),
-            max: moving.max.inf(&near.max),
-        };
-        if clipped.min.x < clipped.max.x && clipped.min.y < clipped.max.y {
-            clipped
-        } else {
-            moving
-        }
+        let widest = moving
+            .iter()
+            .flatten()
+            .fold(Vec2::zeros(), |w, b| w.sup(&(b.max - b.min)));
+        let start_size = first.max - first.min;
+        // Room around the bodies for them to move, as the editor's fit leaves.
+        let size = (widest.inf(&(start_size * 10.0)) * 2.0).sup(&Vec2::repeat(1.0));
+        let mut centre = (first.min + first.max) / 2.0;
+        moving
+            .iter()
+            .map(|b| {
+                if let Some(b) = b {
+                    centre += ((b.min + b.max) / 2.0 - centre) * 0.2;
+                }
+                Aabb {
+                    min: centre - size / 2.0,
+                    max: centre + size / 2.0,
+                }
+            })
+            .collect()
     }
 
     /// The recording as GIF bytes: `width` × `height` pixels, looping, each frame shown
@@ -116,12 +129,12 @@ impl Recording {
     pub fn to_gif(&self, width: u32, height: u32) -> Result<Vec<u8>, String> {
         let (w, h) = (width.clamp(16, 4096), height.clamp(16, 4096));
         let mut pixmap = Pixmap::new(w, h).ok_or("cannot make a picture of that size")?;
-        let to_pixels = camera(self.view(), w as f64, h as f64);
+        let views = self.views();
         let failed = |e: gif::EncodingError| format!("cannot encode the GIF: {e}");
         let mut encoder = gif::Encoder::new(Vec::new(), w as u16, h as u16, &[]).map_err(failed)?;
         encoder.set_repeat(gif::Repeat::Infinite).map_err(failed)?;
-        for (k, (time, outlines)) in self.frames.iter().enumerate() {
-            paint(&mut pixmap, outlines, &to_pixels);
+        for (k, ((time, outlines), view)) in self.frames.iter().zip(views).enumerate() {
+            paint(&mut pixmap, outlines, &camera(view, w as f64, h as f64));
             let mut rgba = pixmap.data().to_vec();
             // Quantising speed 10: the encoder's default balance of palette and time.
             let mut frame = gif::Frame::from_rgba_speed(w as u16, h as u16, &mut rgba, 10);
@@ -190,12 +203,10 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-/// World to pixels: `view` scaled to fit `w` × `h` with a margin, centred, y down as in
-/// the files.
+/// World to pixels: `view` scaled to fit `w` × `h`, centred, y down as in the files.
 fn camera(view: Aabb, w: f64, h: f64) -> impl Fn(Vec2) -> (f32, f32) {
     let size = view.max - view.min;
-    let margin = 0.08;
-    let zoom = ((w / size.x.max(1e-9)).min(h / size.y.max(1e-9))) * (1.0 - 2.0 * margin);
+    let zoom = (w / size.x.max(1e-9)).min(h / size.y.max(1e-9));
     let centre = (view.min + view.max) / 2.0;
     move |p: Vec2| {
         let d = (p - centre) * zoom;
