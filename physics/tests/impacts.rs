@@ -157,32 +157,39 @@ fn unequal_pendulums_part_as_elastic_collision_says() {
 
 /// With cor 1 and no friction the cradle swings on: over twenty impacts its energy
 /// never rises by more than 1% of the swing's (the energy at release above the energy
-/// at rest).
+/// at rest), one or two released, under `exact` and under the soft step (whose own
+/// bounce of two pendulums meeting within a step gained 6% before such a step was taken
+/// again with the pair in the impact pass).
 #[test]
 fn the_cradle_gains_no_energy_over_twenty_impacts() {
     let release = RELEASE_DEGREES.to_radians();
-    let mut c = cradle(ContactSolver::Exact, true, 1, release);
-    let energy = |c: &Cradle| c.world.kinetic_energy() + c.world.potential_energy();
-    let start = energy(&c);
-    let at_rest = cradle(ContactSolver::Exact, true, 0, 0.0);
-    let swing = start - energy(&at_rest);
-    let (mut impacts, mut touching, mut highest) = (0, false, start);
-    let mut steps = 0;
-    while impacts < 20 {
-        c.world.step(H);
-        steps += 1;
-        assert!(steps < 100_000, "only {impacts} impacts");
-        let now = c.world.contacts().iter().any(|k| k.normal_impulse > 0.0);
-        impacts += usize::from(now && !touching);
-        touching = now;
-        highest = highest.max(energy(&c));
+    for solver in [ContactSolver::Exact, ContactSolver::Soft] {
+        for released in [1, 2] {
+            let mut c = cradle(solver, true, released, release);
+            let energy = |c: &Cradle| c.world.kinetic_energy() + c.world.potential_energy();
+            let start = energy(&c);
+            let at_rest = cradle(solver, true, 0, 0.0);
+            let swing = start - energy(&at_rest);
+            let (mut impacts, mut touching, mut highest) = (0, false, start);
+            let mut steps = 0;
+            while impacts < 20 {
+                c.world.step(H);
+                steps += 1;
+                assert!(steps < 100_000, "only {impacts} impacts");
+                let now = c.world.contacts().iter().any(|k| k.normal_impulse > 0.0);
+                impacts += usize::from(now && !touching);
+                touching = now;
+                highest = highest.max(energy(&c));
+            }
+            let gained = (highest - start) / swing;
+            assert!(
+                gained < 0.01,
+                "{} with {released} released: gained {:.3}% of the swing's energy",
+                solver.name(),
+                100.0 * gained
+            );
+        }
     }
-    let gained = (highest - start) / swing;
-    assert!(
-        gained < 0.01,
-        "gained {:.3}% of the swing's energy",
-        100.0 * gained
-    );
 }
 
 /// Boxes of 1 m, cor 1, no friction.
