@@ -80,6 +80,14 @@ fn a_box_dragged_into_a_scene_is_a_new_body_placed_there_and_one_undo_takes_both
         "{}",
         h.state().status()
     );
+    // Esc goes back to selecting; the shortcut sheet lists the tools.
+    h.key_press(Key::Escape);
+    h.run_steps(2);
+    drag_world(&mut h, (600.0, 100.0), (650.0, 150.0));
+    assert_eq!(h.state().model().bodies.len(), count, "a drag now selects");
+    h.key_press(Key::F1);
+    h.run_steps(2);
+    h.get_by_label_contains("Box tool");
 }
 
 fn click_label(h: &mut Harness<'_, RoboSimApp>, label: &str) {

@@ -86,6 +86,11 @@ fn a_rubber_band_selects_what_it_touches_and_shift_adds() {
     // Shift adds the ball (a circle-like polygon about (250, 100)).
     band(&mut h, (230.0, 80.0), (270.0, 120.0), Modifiers::SHIFT);
     assert_eq!(picked_ids(&h), ["ball", "box 2", "box 3", "box 4"]);
+    // Shift+click takes one out, and puts it back.
+    click_world(&mut h, 400.0, 305.0, Modifiers::SHIFT);
+    assert_eq!(picked_ids(&h), ["ball", "box 2", "box 4"]);
+    click_world(&mut h, 400.0, 305.0, Modifiers::SHIFT);
+    assert_eq!(picked_ids(&h), ["ball", "box 2", "box 3", "box 4"]);
     // A plain band replaces the selection; a click on empty canvas clears it.
     band(&mut h, (360.0, 135.0), (440.0, 165.0), Modifiers::NONE);
     assert_eq!(picked_ids(&h), ["box 8"]);
