@@ -78,7 +78,8 @@ pub enum Selection {
     Body(String),
 }
 
-/// A placement copied with Ctrl+C, to paste into a scene or a robot.
+/// One placement as Ctrl+C copies it (the clipboard, `placements::Clipboard`, holds
+/// several), to paste into a scene or a robot.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Copied {
     SceneRobot(crate::model::SceneRobot),
