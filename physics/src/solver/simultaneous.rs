@@ -456,17 +456,7 @@ impl SimultaneousSolver {
         {
             return;
         }
-        let mut k = 0;
-        while k < self.island_contacts.len() {
-            let pair = |c: &Contact| (c.body_a, c.body_b);
-            let first = pair(&self.island_contacts[k].1);
-            let n = self.island_contacts[k..]
-                .iter()
-                .take_while(|(_, c)| pair(c) == first)
-                .count();
-            self.pair_spans.push((k, k + n));
-            k += n;
-        }
+        self.find_pair_spans();
         self.bounced.resize(self.pair_spans.len(), false);
         self.impact_joints.clear();
         self.impact_joints.extend(
@@ -487,28 +477,7 @@ impl SimultaneousSolver {
         'sweeps: loop {
             let mut any = false;
             for p in 0..self.pair_spans.len() {
-                let (start, end) = self.pair_spans[p];
-                self.impact_contacts.clear();
-                for &(index, c) in &self.island_contacts[start..end] {
-                    let a = &bodies[c.body_a as usize];
-                    let b = &bodies[c.body_b as usize];
-                    let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
-                    // What the step's forces add along the normal: reflected never, but
-                    // counted in whether the pair meets this step.
-                    let forces = c.normal_velocity - c.approach_velocity;
-                    let (approach_velocity, normal_velocity) = match kick {
-                        Kick::Applied => (now - forces, now),
-                        Kick::Pending => (now, now + forces),
-                    };
-                    self.impact_contacts.push((
-                        index,
-                        Contact {
-                            approach_velocity,
-                            normal_velocity,
-                            ..c
-                        },
-                    ));
-                }
+                self.read_impact_pair(p, bodies, kick);
                 if !self
                     .impact_contacts
                     .iter()
@@ -521,46 +490,8 @@ impl SimultaneousSolver {
                 }
                 budget -= 1;
                 any = true;
-
                 self.bounced[p] = true;
-                velocity_rows(
-                    &self.impact_contacts,
-                    &self.impact_joints,
-                    bodies,
-                    &impact_targets,
-                    &mut self.rows,
-                );
-                // The pins hold their velocities as they are: the pass moves nothing but
-                // the impact through them.
-                for row in self.rows.iter_mut() {
-                    if matches!(row.kind, RowKind::JointX(_) | RowKind::JointY(_)) {
-                        row.b = 0.0;
-                    }
-                }
-                self.guess.clear();
-                self.solve_rows_dense(bodies);
-                for (row, &x) in self.rows.iter().zip(&self.x) {
-                    row.apply(bodies, x);
-                    let local = |i: u32| {
-                        self.island_contacts[start..end]
-                            .iter()
-                            .position(|&(index, _)| index == i)
-                            .map(|k| start + k)
-                    };
-                    match row.kind {
-                        RowKind::ContactNormal(i) => {
-                            if let Some(k) = local(i) {
-                                self.impact_impulses[k].0 += x;
-                            }
-                        }
-                        RowKind::ContactTangent(i) | RowKind::SharedTangent(i, _) => {
-                            if let Some(k) = local(i) {
-                                self.impact_impulses[k].1 += x;
-                            }
-                        }
-                        _ => {}
-                    }
-                }
+                self.solve_impact_pair(p, bodies, &impact_targets);
             }
             if !any {
                 break;
@@ -571,6 +502,93 @@ impl SimultaneousSolver {
                 for (_, c) in &mut self.island_contacts[start..end] {
                     c.approach_velocity = 0.0;
                 }
+            }
+        }
+    }
+
+    /// Each body pair's span of `island_contacts` (a pair's points come one after another).
+    fn find_pair_spans(&mut self) {
+        let pair = |c: &Contact| (c.body_a, c.body_b);
+        let mut k = 0;
+        while k < self.island_contacts.len() {
+            let first = pair(&self.island_contacts[k].1);
+            let n = self.island_contacts[k..]
+                .iter()
+                .take_while(|(_, c)| pair(c) == first)
+                .count();
+            self.pair_spans.push((k, k + n));
+            k += n;
+        }
+    }
+
+    /// Pair `p`'s contacts into `impact_contacts` with their normal velocities as they are
+    /// now, after the impacts already passed on.
+    fn read_impact_pair(&mut self, p: usize, bodies: &[SolverBody], kick: Kick) {
+        let (start, end) = self.pair_spans[p];
+        self.impact_contacts.clear();
+        for &(index, c) in &self.island_contacts[start..end] {
+            let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+            let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
+            // What the step's forces add along the normal: reflected never, but counted in
+            // whether the pair meets this step.
+            let forces = c.normal_velocity - c.approach_velocity;
+            let (approach_velocity, normal_velocity) = match kick {
+                Kick::Applied => (now - forces, now),
+                Kick::Pending => (now, now + forces),
+            };
+            let contact = Contact {
+                approach_velocity,
+                normal_velocity,
+                ..c
+            };
+            self.impact_contacts.push((index, contact));
+        }
+    }
+
+    /// Pair `p`'s impact: its normals and friction with the island's pins, which hold their
+    /// velocities as they are (the pass moves nothing but the impact through them), as one
+    /// LCP; the impulses go on the bodies and into `impact_impulses`.
+    fn solve_impact_pair(
+        &mut self,
+        p: usize,
+        bodies: &mut [SolverBody],
+        targets: &VelocityTargets,
+    ) {
+        let (start, end) = self.pair_spans[p];
+        velocity_rows(
+            &self.impact_contacts,
+            &self.impact_joints,
+            bodies,
+            targets,
+            &mut self.rows,
+        );
+        for row in self.rows.iter_mut() {
+            if matches!(row.kind, RowKind::JointX(_) | RowKind::JointY(_)) {
+                row.b = 0.0;
+            }
+        }
+        self.guess.clear();
+        self.solve_rows_dense(bodies);
+        for (row, &x) in self.rows.iter().zip(&self.x) {
+            row.apply(bodies, x);
+            let local = |i: u32| {
+                self.island_contacts[start..end]
+                    .iter()
+                    .position(|&(index, _)| index == i)
+                    .map(|k| start + k)
+            };
+            match row.kind {
+                RowKind::ContactNormal(i) => {
+                    if let Some(k) = local(i) {
+                        self.impact_impulses[k].0 += x;
+                    }
+                }
+                RowKind::ContactTangent(i) | RowKind::SharedTangent(i, _) => {
+                    if let Some(k) = local(i) {
+                        self.impact_impulses[k].1 += x;
+                    }
+                }
+                _ => {}
             }
         }
     }
