@@ -36,6 +36,11 @@ impl SolverBody {
         }
     }
 
+    /// Whether impulses move the body (not static, not held by `auto`).
+    pub(crate) fn moves(&self) -> bool {
+        self.inv_mass > 0.0 || self.inv_inertia > 0.0
+    }
+
     pub(crate) fn velocity_at(&self, point: Vec2) -> Vec2 {
         self.velocity + cross_scalar(self.angular_velocity, point - self.position)
     }

@@ -774,9 +774,6 @@ impl SimultaneousSolver {
 /// Whether contact `c` bounces this step between two moving bodies: an impact that may
 /// pass on through the bodies at rest in contact with them.
 fn passes_on(c: &Contact, bodies: &[SolverBody], targets: &VelocityTargets) -> bool {
-    let moves = |i: u32| {
-        let b = &bodies[i as usize];
-        b.inv_mass > 0.0 || b.inv_inertia > 0.0
-    };
+    let moves = |i: u32| bodies[i as usize].moves();
     c.bounces(targets.dt, targets.bounce_below) && moves(c.body_a) && moves(c.body_b)
 }

@@ -683,8 +683,13 @@ impl World {
         // start foretold (a pendulum speeding up through its pin) would bounce in the soft
         // step's own restitution, which shares the impulse: the step is taken again with
         // the impact pass bouncing those pairs too.
-        let may_bounce =
-            self.settings.propagate_impacts && self.contacts.iter().any(|c| c.restitution > 0.0);
+        let bodies = &self.scratch.solver_bodies;
+        let moves = |i: u32| bodies[i as usize].moves();
+        let may_bounce = self.settings.propagate_impacts
+            && self
+                .contacts
+                .iter()
+                .any(|c| c.restitution > 0.0 && moves(c.body_a) && moves(c.body_b));
         let found = may_bounce.then(|| self.contacts.clone());
         let mut unforeseen = Vec::new();
         loop {
@@ -723,10 +728,7 @@ impl World {
     fn unforeseen_impacts(&self, dt: f64) -> Vec<(u32, u32)> {
         let bounce_below = restitution_threshold(self.gravity, dt);
         let bodies = &self.scratch.solver_bodies;
-        let moves = |i: u32| {
-            let b = &bodies[i as usize];
-            b.inv_mass > 0.0 || b.inv_inertia > 0.0
-        };
+        let moves = |i: u32| bodies[i as usize].moves();
         let mut pairs: Vec<(u32, u32)> = self
             .contacts
             .iter()
