@@ -398,3 +398,26 @@ fn the_default_cradle_sends_out_one_pendulum() {
         "each pendulum's widest swing over the release angle: {widest:.3?}"
     );
 }
+
+/// Two pinned bodies that may collide and overlap from the start (a fuzzed database):
+/// their contact contradicts their pin, and the impact pass's answer for them gained
+/// energy without bound (the state went NaN in two steps under `auto`); it is refused,
+/// and every solver keeps the state finite.
+#[test]
+fn a_pinned_pair_that_collides_keeps_every_number_finite() {
+    let (db, problems) = Database::load(std::path::Path::new(
+        "tests/corpus/pinned_pair_that_collides",
+    ));
+    assert!(problems.iter().all(|p| !p.is_error()), "{problems:#?}");
+    for solver in ContactSolver::ALL {
+        let mut sim = Simulation::new(&db.model, "s", None, Some(solver)).unwrap();
+        for step in 0..20 {
+            sim.step();
+            assert!(
+                !sim.has_non_finite_state(),
+                "{}: non-finite at step {step}",
+                solver.name()
+            );
+        }
+    }
+}

@@ -41,6 +41,21 @@ impl SolverBody {
         self.inv_mass > 0.0 || self.inv_inertia > 0.0
     }
 
+    /// ½ m v² + ½ I ω² (0 for a body impulses do not move).
+    pub(crate) fn kinetic_energy(&self) -> f64 {
+        let linear = if self.inv_mass > 0.0 {
+            self.velocity.norm_squared() / self.inv_mass
+        } else {
+            0.0
+        };
+        let angular = if self.inv_inertia > 0.0 {
+            self.angular_velocity * self.angular_velocity / self.inv_inertia
+        } else {
+            0.0
+        };
+        0.5 * (linear + angular)
+    }
+
     pub(crate) fn velocity_at(&self, point: Vec2) -> Vec2 {
         self.velocity + cross_scalar(self.angular_velocity, point - self.position)
     }
