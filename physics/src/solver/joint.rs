@@ -675,9 +675,7 @@ impl JointBlockSolver {
         bodies: &mut [SolverBody],
         mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
     ) {
-        let dynamic = |slot: u32| {
-            bodies[slot as usize].inv_mass > 0.0 || bodies[slot as usize].inv_inertia > 0.0
-        };
+        let dynamic = |slot: u32| bodies[slot as usize].moves();
         group_by_island(
             joints.len(),
             bodies.len(),

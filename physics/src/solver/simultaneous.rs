@@ -210,8 +210,7 @@ impl SimultaneousSolver {
             }
             // The island's velocities changed: its contacts' approaches are read again.
             for &(i, c) in &self.island_contacts {
-                let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-                let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
+                let now = c.relative_velocity(bodies).dot(&c.normal);
                 let contact = &mut contacts[i as usize];
                 let kick = contact.normal_velocity - contact.approach_velocity;
                 contact.approach_velocity = now;
@@ -346,9 +345,7 @@ impl SimultaneousSolver {
     ) {
         let nc = contacts.len();
         let joint_count = if with_joints { joints.len() } else { 0 };
-        let dynamic = |slot: u32| {
-            bodies[slot as usize].inv_mass > 0.0 || bodies[slot as usize].inv_inertia > 0.0
-        };
+        let dynamic = |slot: u32| bodies[slot as usize].moves();
         let ends = |i: usize| {
             if i < nc {
                 (contacts[i].body_a, contacts[i].body_b)
@@ -532,8 +529,7 @@ impl SimultaneousSolver {
         let (start, end) = self.pair_spans[p];
         self.impact_contacts.clear();
         for &(index, c) in &self.island_contacts[start..end] {
-            let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
-            let now = (a.velocity_at(c.point) - b.velocity_at(c.point)).dot(&c.normal);
+            let now = c.relative_velocity(bodies).dot(&c.normal);
             // What the step's forces add along the normal: reflected never, but counted in
             // whether the pair meets this step.
             let forces = c.normal_velocity - c.approach_velocity;

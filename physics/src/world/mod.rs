@@ -679,10 +679,11 @@ impl World {
             _ => (Vec2::zeros(), 0.0),
         }));
         s.accelerations.push((Vec2::zeros(), 0.0));
-        // Two moving bodies that meet within the step sooner than their velocities at its
-        // start foretold (a pendulum speeding up through its pin) would bounce in the soft
-        // step's own restitution, which shares the impulse: the step is taken again with
-        // the impact pass bouncing those pairs too.
+        // The impact pass runs only where two moving bodies may bounce (a pile of cor 0
+        // pays one look at its contacts). Two that meet within the step sooner than their
+        // velocities at its start foretold (a pendulum speeding up through its pin) would
+        // bounce in the soft step's own restitution, which shares the impulse: the step is
+        // taken again with the impact pass bouncing those pairs too.
         let bodies = &self.scratch.solver_bodies;
         let moves = |i: u32| bodies[i as usize].moves();
         let may_bounce = self.settings.propagate_impacts
@@ -693,7 +694,7 @@ impl World {
         let found = may_bounce.then(|| self.contacts.clone());
         let mut unforeseen = Vec::new();
         loop {
-            if self.settings.propagate_impacts {
+            if may_bounce {
                 self.propagate_impacts_before_soft_step(dt, &unforeseen);
             }
             let s = &mut self.scratch;
@@ -749,10 +750,6 @@ impl World {
     /// which then bounces only what the pass left.
     /// `unforeseen`: pairs to bounce as meeting this step whatever their velocities say.
     fn propagate_impacts_before_soft_step(&mut self, dt: f64, unforeseen: &[(u32, u32)]) {
-        // Most scenes bounce nothing: a pile of cor 0 pays one look at its contacts.
-        if self.contacts.iter().all(|c| c.restitution == 0.0) {
-            return;
-        }
         let s = &mut self.scratch;
         // The soft step's contacts carry the velocities of the step's start; whether
         // a pair meets this step also takes the step's forces (as `exact`'s do).
