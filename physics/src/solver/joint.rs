@@ -391,38 +391,45 @@ fn coupled_joints(joints: &[JointConstraint], bodies: &[SolverBody]) -> Vec<Vec<
         .collect()
 }
 
+/// What stays the same while an island's impulses are found and applied: each joint's
+/// arms at the bodies' present angles (impulses change velocities, not angles) and the
+/// joints each joint shares a moving body with.
+struct IslandLayout {
+    arms_now: Vec<(Vec2, Vec2)>,
+    coupled: Vec<Vec<usize>>,
+}
+
+impl IslandLayout {
+    fn new(joints: &[JointConstraint], bodies: &[SolverBody]) -> Self {
+        let angle = |i: u32| bodies[i as usize].angle;
+        Self {
+            arms_now: joints
+                .iter()
+                .map(|j| j.arms((angle(j.body_a), angle(j.body_b))))
+                .collect(),
+            coupled: coupled_joints(joints, bodies),
+        }
+    }
+}
+
 /// The impulses that make `residual` zero for all joints of an island at once, to first
-/// order: K ψ = −residual. `None` if K is singular beyond repair.
+/// order: K ψ = −residual, with each joint's gap observed at `observed_arms` (the arms
+/// turned to where the gap is measured). `None` if K is singular beyond repair.
 fn island_impulses(
     joints: &[JointConstraint],
     bodies: &[SolverBody],
-    ahead: f64,
-    residual: impl Fn(&JointConstraint, &[SolverBody]) -> Vec2,
+    layout: &IslandLayout,
+    observed_arms: &[(Vec2, Vec2)],
+    residual: impl Fn(usize) -> Vec2,
 ) -> Option<DVector<f64>> {
-    let m = joints.len();
-    let angle_ahead =
-        |i: u32| bodies[i as usize].angle + ahead * bodies[i as usize].angular_velocity;
-    let arms_ahead: Vec<_> = joints
-        .iter()
-        .map(|j| j.arms((angle_ahead(j.body_a), angle_ahead(j.body_b))))
-        .collect();
-    let arms_now: Vec<_> = joints
-        .iter()
-        .map(|j| {
-            j.arms((
-                bodies[j.body_a as usize].angle,
-                bodies[j.body_b as usize].angle,
-            ))
-        })
-        .collect();
-    let n = 2 * m;
+    let n = 2 * joints.len();
     let mut k = vec![0.0; n * n];
     let mut rhs = DVector::<f64>::zeros(n);
-    for (p, coupled) in coupled_joints(joints, bodies).into_iter().enumerate() {
-        for q in coupled {
+    for (p, coupled) in layout.coupled.iter().enumerate() {
+        for &q in coupled {
             let block = coupling_block(
-                (&joints[p], arms_ahead[p]),
-                (&joints[q], arms_now[q]),
+                (&joints[p], observed_arms[p]),
+                (&joints[q], layout.arms_now[q]),
                 bodies,
             );
             for (r, row) in block.iter().enumerate() {
@@ -431,7 +438,7 @@ fn island_impulses(
                 }
             }
         }
-        let d = residual(&joints[p], bodies);
+        let d = residual(p);
         rhs[2 * p] = -d.x;
         rhs[2 * p + 1] = -d.y;
     }
@@ -453,29 +460,48 @@ fn island_impulses(
     psi.iter().all(|v| v.is_finite()).then_some(psi)
 }
 
-/// Applies `fraction` of the island impulses `psi` at the joints' current anchors.
+/// Applies `fraction` of the island impulses `psi` at the joints' present anchors.
 fn apply_island_impulses(
     joints: &[JointConstraint],
     bodies: &mut [SolverBody],
+    layout: &IslandLayout,
     psi: &DVector<f64>,
     fraction: f64,
 ) {
     for (p, j) in joints.iter().enumerate() {
         let impulse = Vec2::new(psi[2 * p], psi[2 * p + 1]) * fraction;
         let (ia, ib) = (j.body_a as usize, j.body_b as usize);
-        let (r_a, r_b) = j.arms((bodies[ia].angle, bodies[ib].angle));
+        let (r_a, r_b) = layout.arms_now[p];
         let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
         bodies[ia].apply_impulse(impulse, pa);
         bodies[ib].apply_impulse(-impulse, pb);
     }
 }
 
-/// Largest remaining predicted gap of the island (relative to each joint's target).
-fn worst_predicted_gap(joints: &[JointConstraint], bodies: &[SolverBody], dt: f64) -> f64 {
-    joints
-        .iter()
-        .map(|j| (j.predicted_gap(bodies, dt) - j.gap_target).norm())
-        .fold(0.0, f64::max)
+/// Each joint's predicted gap `dt` on (relative to its target) and its arms turned to
+/// where that gap is measured; returns the largest gap.
+fn predicted_gaps(
+    joints: &[JointConstraint],
+    bodies: &[SolverBody],
+    dt: f64,
+    arms_ahead: &mut Vec<(Vec2, Vec2)>,
+    gaps: &mut Vec<Vec2>,
+) -> f64 {
+    arms_ahead.clear();
+    gaps.clear();
+    let mut worst: f64 = 0.0;
+    for j in joints {
+        let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
+        let turned = |b: &SolverBody| Rot::new(b.angle + b.angular_velocity * dt);
+        let arms = j.arms_turned((turned(a), turned(b)));
+        let end_a = a.position + a.velocity * dt + arms.0;
+        let end_b = b.position + b.velocity * dt + arms.1;
+        let gap = end_a - end_b - j.gap_target;
+        worst = worst.max(gap.norm());
+        arms_ahead.push(arms);
+        gaps.push(gap);
+    }
+    worst
 }
 
 /// Newton steps on the island's predicted gaps. Each step must shrink the worst gap; if a
@@ -488,23 +514,25 @@ fn close_island_gaps(
     dt: f64,
     it: &JointIterations,
 ) -> bool {
-    let mut worst = worst_predicted_gap(joints, bodies, dt);
+    let layout = IslandLayout::new(joints, bodies);
+    let (mut arms_ahead, mut gaps) = (Vec::new(), Vec::new());
+    let mut worst = predicted_gaps(joints, bodies, dt, &mut arms_ahead, &mut gaps);
+    let mut saved: Vec<(usize, SolverBody)> = Vec::new();
     for _ in 0..it.max_sweeps.min(10) {
         if worst < it.position_tolerance {
             break;
         }
-        let residual =
-            |j: &JointConstraint, b: &[SolverBody]| (j.predicted_gap(b, dt) - j.gap_target) / dt;
-        let Some(psi) = island_impulses(joints, bodies, dt, residual) else {
+        let residual = |p: usize| gaps[p] / dt;
+        let Some(psi) = island_impulses(joints, bodies, &layout, &arms_ahead, residual) else {
             return false;
         };
-        let saved: Vec<(usize, SolverBody)> =
-            island_bodies(joints).map(|i| (i, bodies[i])).collect();
+        saved.clear();
+        saved.extend(island_bodies(joints).map(|i| (i, bodies[i])));
         let mut fraction = 1.0;
         let mut improved = false;
         for _ in 0..5 {
-            apply_island_impulses(joints, bodies, &psi, fraction);
-            let now = worst_predicted_gap(joints, bodies, dt);
+            apply_island_impulses(joints, bodies, &layout, &psi, fraction);
+            let now = predicted_gaps(joints, bodies, dt, &mut arms_ahead, &mut gaps);
             if now < worst {
                 worst = now;
                 improved = true;
@@ -599,7 +627,10 @@ fn repair_island_positions(
         if worst < it.position_tolerance {
             break;
         }
-        let Some(psi) = island_impulses(&joints, bodies, 0.0, repair_residual) else {
+        let layout = IslandLayout::new(&joints, bodies);
+        let residual = |p: usize| repair_residual(&joints[p], bodies);
+        let Some(psi) = island_impulses(&joints, bodies, &layout, &layout.arms_now, residual)
+        else {
             return false;
         };
         let saved: Vec<(usize, SolverBody)> =
@@ -750,10 +781,13 @@ impl JointBlockSolver {
     ) {
         self.for_each_island(joints, bodies, |island, bodies| {
             let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
-            let solved = direct
-                && island_impulses(island, bodies, 0.0, anchor_velocity_gap)
-                    .map(|psi| apply_island_impulses(island, bodies, &psi, 1.0))
-                    .is_some();
+            let solved = direct && {
+                let layout = IslandLayout::new(island, bodies);
+                let residual = |p: usize| anchor_velocity_gap(&island[p], bodies);
+                island_impulses(island, bodies, &layout, &layout.arms_now, residual)
+                    .map(|psi| apply_island_impulses(island, bodies, &layout, &psi, 1.0))
+                    .is_some()
+            };
             if !solved {
                 correct_velocities(island, bodies, it);
             }

@@ -1,0 +1,59 @@
+//! The benchmark's heavy chain (light 1 × 0.1 links holding a 1 m box 500 times heavier
+//! than each, released level) under a chosen solver, for profiling:
+//! `cargo run --release -p pe --example chain_profile -- exact 600 [links]`.
+//! Prints the time per step, the widest any pin opened, and a hash of the final state
+//! (to check that a change leaves the trajectory bit for bit).
+use pe::{BodyDef, ContactSolver, ConvexPolygon, JointDef, Vec2, World};
+use std::time::Instant;
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let name = args.next().unwrap_or_else(|| "exact".into());
+    let Some(solver) = ContactSolver::from_name(&name) else {
+        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
+        eprintln!("unknown solver {name:?}: one of {}", names.join(", "));
+        std::process::exit(2);
+    };
+    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
+    let links: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(10);
+    let mut w = World::new(Vec2::new(0.0, 10.0));
+    w.settings.contact_solver = solver;
+    let link = ConvexPolygon::rectangle(1.0, 0.1).unwrap();
+    let end = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+    let mut previous = None;
+    let mut pins = Vec::new();
+    for i in 0..=links {
+        let def = if i < links {
+            BodyDef::new(link.clone(), 2.0).at(Vec2::new(i as f64 + 0.5, 0.0), 0.0)
+        } else {
+            BodyDef::new(end.clone(), 100.0).at(Vec2::new(links as f64 + 0.5, 0.0), 0.0)
+        };
+        let body = w.add_body(def).unwrap();
+        let pin = JointDef::new(body, previous, Vec2::new(i as f64, 0.0));
+        pins.push(w.add_joint(pin).unwrap());
+        previous = Some(body);
+    }
+    let started = Instant::now();
+    let mut widest: f64 = 0.0;
+    for _ in 0..steps {
+        w.step(1.0 / 60.0);
+        for &pin in &pins {
+            widest = widest.max(w.joint_gap(pin).unwrap());
+        }
+    }
+    let per_step = started.elapsed().as_secs_f64() / steps as f64;
+    let mut hash: u64 = 0;
+    for (_, b) in w.bodies() {
+        let state = [b.position.x, b.position.y, b.angle];
+        for v in state
+            .into_iter()
+            .chain([b.velocity.x, b.velocity.y, b.angular_velocity])
+        {
+            hash = hash.rotate_left(5) ^ v.to_bits();
+        }
+    }
+    println!(
+        "{solver:?}: {links} links, {:.1} µs/step (mean of {steps}); widest pin gap {widest:.2e}; state {hash:016x}",
+        per_step * 1e6
+    );
+}
