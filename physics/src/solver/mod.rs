@@ -109,4 +109,52 @@ impl ContactSolver {
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|s| s.name() == name)
     }
+
+    /// The stage lists a step runs under this solver: the one place the choice is read.
+    pub(crate) fn stage_list(self) -> StageList {
+        match self {
+            ContactSolver::Sequential => StageList::Impulses(ImpulseMethod::Sequential),
+            ContactSolver::Thesis => StageList::Impulses(ImpulseMethod::Thesis),
+            ContactSolver::Exact => StageList::Impulses(ImpulseMethod::Exact),
+            ContactSolver::Soft => StageList::Soft,
+            ContactSolver::Auto => StageList::Auto,
+        }
+    }
+}
+
+/// What a step runs: the impulse stage list with one method for every island, the soft
+/// step, or `auto`'s split of the islands between the impulse list's `Exact` and the soft
+/// step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum StageList {
+    Impulses(ImpulseMethod),
+    Soft,
+    Auto,
+}
+
+/// How the impulse stage list solves contacts and pins.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum ImpulseMethod {
+    /// One contact at a time, then the pins in their own passes.
+    Sequential,
+    /// The thesis's normal LCP, then its friction LCP, then the pins.
+    Thesis,
+    /// One boxed LCP per island with contacts, friction, pins and motors.
+    Exact,
+}
+
+impl ImpulseMethod {
+    /// Overlap is pushed out by moving the pair (SPEC §3.1) before the solve: the
+    /// thesis's and the sequential method's way. The exact method removes it by split
+    /// impulses after its solve instead, which keeps the pins' and contacts' impulses
+    /// consistent.
+    pub(crate) fn pushes_apart(self) -> bool {
+        self != ImpulseMethod::Exact
+    }
+
+    /// The pins' position pass keeps the motors' impulses the solve already applied this
+    /// step: only the exact method solves motors with the contacts.
+    pub(crate) fn solves_motors_with_contacts(self) -> bool {
+        self == ImpulseMethod::Exact
+    }
 }

@@ -2,6 +2,7 @@
 //! the other's bodies still.
 
 use super::World;
+use crate::solver::ImpulseMethod;
 
 /// Seconds an island that went over the exact solver's pivot budget stays on the soft
 /// step under `auto`.
@@ -79,7 +80,7 @@ impl World {
     pub(super) fn step_auto(&mut self, dt: f64) {
         let (exact, soft) = self.mark_soft_islands(dt);
         if !soft {
-            self.step_impulses(dt);
+            self.step_impulses(ImpulseMethod::Exact, dt);
             self.keep_over_budget_on_soft(dt);
             self.scratch
                 .auto_reports
@@ -97,7 +98,7 @@ impl World {
             return;
         }
         self.hold_where(true);
-        self.step_impulses(dt);
+        self.step_impulses(ImpulseMethod::Exact, dt);
         self.release_held();
         self.keep_over_budget_on_soft(dt);
         let s = &mut self.scratch;

@@ -4,7 +4,7 @@
 
 use super::{MAX_SUBSTEPS, World};
 use crate::body::Body;
-use crate::solver::ContactSolver;
+use crate::solver::ImpulseMethod;
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
 use crate::solver::simultaneous::FrictionModel;
@@ -108,14 +108,6 @@ impl World {
         }
     }
 
-    /// The solver the impulse stage list runs as: `auto` runs it as `exact`.
-    fn impulse_solver(&self) -> ContactSolver {
-        match self.settings.contact_solver {
-            ContactSolver::Auto => ContactSolver::Exact,
-            solver => solver,
-        }
-    }
-
     /// Broken joints move towards closing, by positions only.
     pub(super) fn repair_broken_joints(&mut self, dt: f64) {
         if self.joints.is_empty() {
@@ -152,9 +144,9 @@ impl World {
 
     /// The thesis removes overlap directly: each pair is pushed apart along its normal by
     /// its depth, shared by inverse mass (SPEC §3.1). Positions only.
-    pub(super) fn push_apart(&mut self) {
-        if self.impulse_solver() == ContactSolver::Exact {
-            return; // the exact solver removes depth by split impulses instead
+    pub(super) fn push_apart(&mut self, method: ImpulseMethod) {
+        if !method.pushes_apart() {
+            return;
         }
         for m in &self.manifolds {
             let depth = m.depth();
@@ -179,8 +171,7 @@ impl World {
 
     /// Stages 5–6: contact impulses (with pins and motors in the exact solver), then joint
     /// position prediction, then (exact solver) the split-impulse depth correction.
-    pub(super) fn solve_constraints(&mut self, dt: f64) {
-        let solver = self.impulse_solver();
+    pub(super) fn solve_constraints(&mut self, method: ImpulseMethod, dt: f64) {
         self.gather_solver_bodies();
         let s = &mut self.scratch;
         let targets = VelocityTargets {
@@ -189,8 +180,8 @@ impl World {
             friction: true,
             close_joint_gaps: true,
         };
-        match solver {
-            ContactSolver::Sequential | ContactSolver::Soft | ContactSolver::Auto => {
+        match method {
+            ImpulseMethod::Sequential => {
                 s.simultaneous.reports.clear();
                 solve_sequential(
                     &mut self.contacts,
@@ -199,8 +190,8 @@ impl World {
                     targets.bounce_below,
                 )
             }
-            ContactSolver::Thesis | ContactSolver::Exact => {
-                let model = if solver == ContactSolver::Thesis {
+            ImpulseMethod::Thesis | ImpulseMethod::Exact => {
+                let model = if method == ImpulseMethod::Thesis {
                     FrictionModel::TwoStage
                 } else {
                     FrictionModel::Coupled
@@ -224,10 +215,10 @@ impl World {
                 &mut s.solver_bodies,
                 dt,
                 &it,
-                solver == ContactSolver::Exact,
+                method.solves_motors_with_contacts(),
             );
         }
-        if solver == ContactSolver::Exact {
+        if !method.pushes_apart() {
             s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
             s.simultaneous.separate(
                 &self.contacts,

@@ -29,7 +29,7 @@ use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
 use crate::solver::soft::{SoftSettings, SoftStepSolver};
 use crate::solver::system::VelocityTargets;
-use crate::solver::{ContactSolver, SolverBody};
+use crate::solver::{ImpulseMethod, SolverBody, StageList};
 use crate::stage_clock::{self, Stage};
 
 /// A joint to be made: the bodies and the shared world point they pin together, given
@@ -603,10 +603,10 @@ impl World {
             }));
         }
         self.apply_motor_torques(dt);
-        match self.settings.contact_solver {
-            ContactSolver::Soft => self.step_soft(dt),
-            ContactSolver::Auto => self.step_auto(dt),
-            _ => self.step_impulses(dt),
+        match self.settings.contact_solver.stage_list() {
+            StageList::Impulses(method) => self.step_impulses(method, dt),
+            StageList::Soft => self.step_soft(dt),
+            StageList::Auto => self.step_auto(dt),
         }
         self.clear_forces();
         self.step_count += 1;
@@ -624,7 +624,7 @@ impl World {
         }
     }
 
-    fn step_impulses(&mut self, dt: f64) {
+    fn step_impulses(&mut self, method: ImpulseMethod, dt: f64) {
         self.repair_broken_joints(dt);
         let mut substeps = self.substeps_for(dt);
         // A joint still broken is being repaired on purpose over several steps; only
@@ -638,8 +638,8 @@ impl World {
                 self.correct_joint_velocities(h);
                 self.integrate_velocities(h);
                 self.detect_contacts(h, Pipeline::Impulses);
-                self.push_apart();
-                self.solve_constraints(h);
+                self.push_apart(method);
+                self.solve_constraints(method, h);
                 self.place_bounces_at_impact(h);
                 self.integrate_positions(h);
                 self.for_each_motor(|m| {
@@ -783,10 +783,10 @@ impl World {
     /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
     /// `thesis` the last substep's islands; under `soft` the step's; under `auto` both passes'.
     pub fn island_reports(&self) -> &[IslandReport] {
-        match self.settings.contact_solver {
-            ContactSolver::Soft => &self.scratch.soft.reports,
-            ContactSolver::Auto => &self.scratch.auto_reports,
-            _ => &self.scratch.simultaneous.reports,
+        match self.settings.contact_solver.stage_list() {
+            StageList::Impulses(_) => &self.scratch.simultaneous.reports,
+            StageList::Soft => &self.scratch.soft.reports,
+            StageList::Auto => &self.scratch.auto_reports,
         }
     }
 }
@@ -795,6 +795,7 @@ impl World {
 mod tests {
     use super::*;
     use crate::shape::ConvexPolygon;
+    use crate::solver::ContactSolver;
 
     /// A manifold that goes into the kept plan's lanes is not written to the soft step's
     /// points; when the plan changes after all, or something bounces, they are built
