@@ -66,7 +66,7 @@ pub fn run_pe_alone() {
 /// the steps from `from` on (half way by default), from `pe::stage_clock`.
 fn print_stage_cycles(from: Option<usize>) {
     use pe::stage_clock;
-    if !stage_clock::ENABLED {
+    if !cfg!(feature = "stages") {
         eprintln!("stages: build with `--features stages` to count them");
         std::process::exit(2);
     }
@@ -107,7 +107,7 @@ pub fn run_stages_beside_peers() {
         eprintln!("stages: one of {}", pile_scenes().join(", "));
         std::process::exit(2);
     };
-    if !stage_clock::ENABLED {
+    if !cfg!(feature = "stages") {
         eprintln!("stages: build with `--features stages` to count them");
         std::process::exit(2);
     }

@@ -25,10 +25,10 @@
 //!   [`MotorError`], [`ShapeError`]), against the [`limits`] among others.
 //! - Stepping: [`World::step`], or [`World::try_step`] for the reason a step is refused
 //!   ([`StepError`]), as the world's [`StepSettings`] say ([`ContactSolver`],
-//!   [`Integrator`], [`JointSolver`]).
+//!   [`Integrator`]).
 //! - Reading the results: each [`Body`] by its [`BodyHandle`], each [`Joint`] by its
 //!   [`JointHandle`], the last step's [`Contact`]s and [`Manifold`]s, and how each island
-//!   was solved ([`IslandReport`]).
+//!   was solved ([`IslandReport`]); what the steps so far did, counted ([`StepStats`]).
 //! - Geometry: [`Vec2`] (nalgebra's), [`Aabb`], [`convex_hull`], and the separating-axis
 //!   test the step finds contacts by, on polygons placed in the world ([`collide_polygons`]
 //!   on [`WorldPolygon`]s), by which the benchmark judges every engine's overlaps.
@@ -53,7 +53,7 @@ pub use crate::{
     solver::{
         ContactSolver,
         contact::Contact,
-        joint::{Joint, JointHandle, JointMotor, JointSolver},
+        joint::{Joint, JointHandle, JointMotor},
         motor::{BodyMotor, MotorError},
         simultaneous::{IslandMethod, IslandReport},
         soft::lane_path_name,
@@ -61,5 +61,6 @@ pub use crate::{
     world::{
         FALL_PER_STEP, JointDef, JointError, StepError, World,
         settings::{Integrator, StepSettings},
+        stats::StepStats,
     },
 };

@@ -92,9 +92,6 @@ impl Stage {
     }
 }
 
-/// Whether this build counts (the feature `stage-clock`).
-pub const ENABLED: bool = cfg!(feature = "stage-clock");
-
 /// When a stage began (`mark`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Mark(#[cfg(feature = "stage-clock")] u64);

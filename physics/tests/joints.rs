@@ -416,3 +416,32 @@ fn pinned_bodies_collide_exactly_when_their_joint_lets_them() {
         "a removed pin no longer keeps them apart"
     );
 }
+
+/// `World::stats` counts what the steps did. A chain of three links pulled along its
+/// length hangs still: under `exact` each step is one substep (nothing turns, no pin
+/// opens); under `soft` the impulse stage list runs none, and the pins' matrix is
+/// factored once a step (its arms do not turn within the step, so every pass reuses it).
+#[test]
+fn stats_count_the_substeps_and_factorisations_of_a_chain_at_rest() {
+    for solver in [ContactSolver::Exact, ContactSolver::Soft] {
+        let (mut world, _) = chain(3, 1.0, 1.0);
+        world.gravity = Vec2::new(G, 0.0);
+        world.settings.contact_solver = solver;
+        assert_eq!(
+            world.stats(),
+            pe::StepStats::default(),
+            "nothing counted yet"
+        );
+        for _ in 0..60 {
+            world.step(1.0 / 60.0);
+        }
+        let stats = world.stats();
+        let counted = (stats.impulse_substeps, stats.soft_pin_factorisations);
+        let expected = if solver == ContactSolver::Exact {
+            (60, 0)
+        } else {
+            (0, 60)
+        };
+        assert_eq!(counted, expected, "{}: {stats:?}", solver.name());
+    }
+}

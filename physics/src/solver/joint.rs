@@ -302,16 +302,6 @@ fn drive_motors_continue(
     }
 }
 
-/// How the joint passes solve the coupled joints of an island.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum JointSolver {
-    /// Each joint alone in turn, repeated (SPEC §3.3 Rec): slow to converge on long chains.
-    GaussSeidel,
-    /// All joints of an island at once: K (2m×2m) factored by Cholesky, per Newton step.
-    #[default]
-    Direct,
-}
-
 /// Buffers for solving joints island by island, reused across steps.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct JointBlockSolver {
@@ -743,7 +733,6 @@ impl JointBlockSolver {
     /// nothing (and costs one pass over the joints) when no joint is broken.
     pub(crate) fn repair_positions(
         &mut self,
-        solver: JointSolver,
         joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
         it: &JointIterations,
@@ -761,7 +750,7 @@ impl JointBlockSolver {
             for &i in &slots {
                 bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
             }
-            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            let direct = island.len() <= DIRECT_JOINT_LIMIT;
             if !(direct && repair_island_positions(island, bodies, it)) {
                 repair_positions_sequential(island, bodies, it);
             }
@@ -774,13 +763,12 @@ impl JointBlockSolver {
     /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
     pub(crate) fn correct_velocities(
         &mut self,
-        solver: JointSolver,
         joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
         it: &JointIterations,
     ) {
         self.for_each_island(joints, bodies, |island, bodies| {
-            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            let direct = island.len() <= DIRECT_JOINT_LIMIT;
             let solved = direct && {
                 let layout = IslandLayout::new(island, bodies);
                 let residual = |p: usize| anchor_velocity_gap(&island[p], bodies);
@@ -799,7 +787,6 @@ impl JointBlockSolver {
     /// `motors_started` says the motors' impulses of this step so far are in place.
     pub(crate) fn correct_positions(
         &mut self,
-        solver: JointSolver,
         joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
         dt: f64,
@@ -808,7 +795,7 @@ impl JointBlockSolver {
     ) {
         self.for_each_island(joints, bodies, |island, bodies| {
             let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
-            let direct = solver == JointSolver::Direct && island.len() <= DIRECT_JOINT_LIMIT;
+            let direct = island.len() <= DIRECT_JOINT_LIMIT;
             if !direct {
                 if has_motor {
                     drive_motors_continue(island, bodies, dt, 10, !motors_started);

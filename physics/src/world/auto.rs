@@ -171,10 +171,7 @@ impl World {
             && last.prefer_soft == s.prefer_soft
         {
             s.auto_links = links;
-            #[cfg(test)]
-            {
-                s.marks_kept += 1;
-            }
+            self.stats.auto_splits_kept += 1;
             return marked;
         }
         s.island_union.reset(n);
@@ -376,7 +373,7 @@ mod tests {
         assert_eq!(asleep, 55, "the pyramid fell asleep");
         // Each step marks three times: the check's, the fresh one, the step's own. The
         // first and the last are kept unless something changed: at most 240 times.
-        let kept = world.scratch.marks_kept;
+        let kept = world.stats().auto_splits_kept;
         assert!((220..=240).contains(&kept), "marks kept {kept} times");
     }
 }

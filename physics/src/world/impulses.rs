@@ -116,12 +116,8 @@ impl World {
         self.gather_solver_bodies();
         let it = self.settings.joint_iterations(dt);
         let s = &mut self.scratch;
-        s.joint_solver.repair_positions(
-            self.settings.joint_solver,
-            &mut s.joint_constraints,
-            &mut s.solver_bodies,
-            &it,
-        );
+        s.joint_solver
+            .repair_positions(&mut s.joint_constraints, &mut s.solver_bodies, &it);
         self.scatter_solver_bodies();
     }
 
@@ -133,12 +129,8 @@ impl World {
         self.gather_solver_bodies();
         let it = self.settings.joint_iterations(dt);
         let s = &mut self.scratch;
-        s.joint_solver.correct_velocities(
-            self.settings.joint_solver,
-            &mut s.joint_constraints,
-            &mut s.solver_bodies,
-            &it,
-        );
+        s.joint_solver
+            .correct_velocities(&mut s.joint_constraints, &mut s.solver_bodies, &it);
         self.scatter_solver_bodies();
     }
 
@@ -210,7 +202,6 @@ impl World {
         if !s.joint_constraints.is_empty() {
             let it = self.settings.joint_iterations(dt);
             s.joint_solver.correct_positions(
-                self.settings.joint_solver,
                 &mut s.joint_constraints,
                 &mut s.solver_bodies,
                 dt,

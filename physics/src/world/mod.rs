@@ -11,12 +11,14 @@ mod integrate;
 pub(crate) mod settings;
 mod sleeping;
 mod solver_bodies;
+pub(crate) mod stats;
 
 use settings::{Integrator, StepSettings};
 
 use auto::{IslandNeeds, LastMarking};
 use candidates::NeighbourScratch;
 use solver_bodies::GapTargets;
+use stats::StepStats;
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::{ManifoldCache, Pose};
@@ -188,6 +190,8 @@ pub struct World {
     /// Per body: under `auto`, the step until which its island stays on the soft step
     /// (`keep_over_budget_on_soft`).
     soft_until: Vec<u64>,
+    /// The world's own counts of `StepStats` (the soft step keeps its own).
+    stats: StepStats,
     scratch: Scratch,
 }
 
@@ -272,8 +276,6 @@ struct Scratch {
     prefer_soft: Vec<bool>,
     in_soft_island: Vec<bool>,
     last_marking: LastMarking,
-    #[cfg(test)]
-    marks_kept: usize,
     held: Vec<(u32, (Vec2, f64))>,
     exact_contacts: Vec<Contact>,
     exact_manifolds: Vec<Manifold>,
@@ -634,6 +636,7 @@ impl World {
             self.save_state();
             let h = dt / substeps as f64;
             self.for_each_motor(|m| m.step_impulse = 0.0);
+            self.stats.impulse_substeps += substeps as u64;
             for _ in 0..substeps {
                 self.correct_joint_velocities(h);
                 self.integrate_velocities(h);
@@ -779,6 +782,16 @@ impl World {
         }
     }
 
+    /// What the steps so far did, counted: see [`StepStats`].
+    pub fn stats(&self) -> StepStats {
+        let soft = &self.scratch.soft;
+        let pins = StepStats {
+            soft_pin_factorisations: soft.pin_factorisations(),
+            ..StepStats::default()
+        };
+        self.stats.merged(&soft.stats).merged(&pins)
+    }
+
     /// How each island was solved in the last step: by which method (see
     /// `IslandMethod`), with how many contacts, joints and rows. Under `exact` and
     /// `thesis` the last substep's islands; under `soft` the step's; under `auto` both passes'.
@@ -851,7 +864,11 @@ mod tests {
             };
             assert_eq!(bits(&skipping), bits(&writing), "step {step}");
         }
-        let (skipped, rebuilt) = skipping.scratch.soft.steps_skipping;
+        let stats = skipping.stats();
+        let (skipped, rebuilt) = (
+            stats.soft_steps_skipping_points,
+            stats.soft_steps_rebuilding_points,
+        );
         assert!(skipped > 200, "{skipped} steps left points unwritten");
         // The landing's step or two, and every step from the bouncing box's first
         // contact on.
@@ -859,7 +876,8 @@ mod tests {
             (50..150).contains(&rebuilt),
             "{rebuilt} built their points again"
         );
-        assert_eq!(writing.scratch.soft.steps_skipping, (0, 0));
+        assert_eq!(writing.stats().soft_steps_skipping_points, 0);
+        assert_eq!(writing.stats().soft_steps_rebuilding_points, 0);
     }
 
     /// Every pair of bodies, not both fixed, whose bounds overlap now: what the broad

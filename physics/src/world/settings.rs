@@ -1,7 +1,7 @@
 //! A world's tuning (`StepSettings`), and the lengths that follow from its length scale.
 
 use crate::solver::ContactSolver;
-use crate::solver::joint::{JointIterations, JointSolver};
+use crate::solver::joint::JointIterations;
 
 /// How velocities and positions advance over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -21,7 +21,6 @@ pub struct StepSettings {
     pub contact_solver: ContactSolver,
     /// A typical body size in the world's length unit (1 for metre-sized bodies).
     pub length_scale: f64,
-    pub joint_solver: JointSolver,
     /// Islands with more LCP rows than this are solved iteratively rather than by pivoting.
     pub dense_row_limit: usize,
     /// Whether islands at rest go to sleep (see `World::step`).
@@ -51,7 +50,6 @@ impl Default for StepSettings {
             integrator: Integrator::default(),
             contact_solver: ContactSolver::default(),
             length_scale: 1.0,
-            joint_solver: JointSolver::default(),
             dense_row_limit: crate::solver::simultaneous::DENSE_ROW_LIMIT,
             sleeping: false,
             continuous: true,

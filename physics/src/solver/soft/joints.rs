@@ -66,11 +66,11 @@ pub(super) struct JointBlock {
     rhs: Vec<f64>,
     /// This step's factor of each island's K, by island (`SoftStepSolver::joint_islands`).
     factors: Vec<IslandFactor>,
-    /// Tests only: K factored in every pass, and how many times it was.
+    /// Tests only: K factored in every pass.
     #[cfg(test)]
     factor_every_pass: bool,
-    #[cfg(test)]
-    factored: usize,
+    /// How many times K was factored (`StepStats::soft_pin_factorisations`).
+    pub(super) factored: u64,
 }
 
 /// An island's factor of K and the bits of the arms it was made from. K depends on the
@@ -200,10 +200,7 @@ impl JointBlock {
         #[cfg(test)]
         let same_arms = same_arms && !self.factor_every_pass;
         if !same_arms {
-            #[cfg(test)]
-            {
-                self.factored += 1;
-            }
+            self.factored += 1;
             let cached = &mut self.factors[index];
             let factored =
                 Self::factor(bodies, island, &self.arms, &mut self.k, &mut cached.factor);
@@ -392,7 +389,7 @@ mod tests {
                 solver.step(&settings, b, &gravity, &mut contacts, j, h, 1.0);
                 bits.push(state_bits(&bodies, &[]));
             }
-            (bits, solver.block.factored)
+            (bits, solver.pin_factorisations() as usize)
         };
         // Swinging down from level: every pass's arms are new but those after a relax pass.
         let down = Vec2::new(0.0, 10.0);

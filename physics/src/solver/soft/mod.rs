@@ -17,6 +17,7 @@ use super::joint::JointConstraint;
 use super::simultaneous::IslandReport;
 use crate::math::{Rot, Vec2};
 use crate::stage_clock::{self, Stage};
+use crate::world::stats::StepStats;
 use batch::{LanePath, PassPlan, PassSettings, PlanInput};
 use pins::PinPlan;
 
@@ -407,12 +408,8 @@ pub(crate) struct SoftStepSolver {
     /// Tests only: every point written, as if no manifold went straight into its lane.
     #[cfg(test)]
     pub(crate) write_every_point: bool,
-    /// Tests only: steps that left points unwritten, and steps that built them again.
-    #[cfg(test)]
-    pub(crate) steps_skipping: (usize, usize),
-    /// Tests only: steps that made their plan before their points.
-    #[cfg(test)]
-    pub(crate) steps_planned_first: usize,
+    /// The soft step's part of the world's `StepStats`.
+    pub(crate) stats: StepStats,
 }
 
 /// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
@@ -468,6 +465,11 @@ fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool
 }
 
 impl SoftStepSolver {
+    /// How many times the pin islands' matrices were factored (`StepStats`).
+    pub(crate) fn pin_factorisations(&self) -> u64 {
+        self.block.factored
+    }
+
     /// Advances `bodies` by `dt`: velocities from `accelerations` (linear, angular per
     /// body), constraints from `contacts` and `joints`, positions and angles integrated.
     #[allow(clippy::too_many_arguments)]
@@ -689,8 +691,8 @@ mod tests {
         topless.drain(58..60);
         let (first, after) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 8);
         // Every step: each changes the plan (the first makes one).
-        assert_eq!(first.steps_planned_first, 8);
-        assert_eq!(after.steps_planned_first, 0);
+        assert_eq!(first.stats.soft_steps_planned_first, 8);
+        assert_eq!(after.stats.soft_steps_planned_first, 0);
         // The singular manifold went as two one-point manifolds.
         let around = first.plan_inputs.iter().map(|p| p.first_and_count());
         let around: Vec<_> = around.filter(|&(k, _)| (22..28).contains(&k)).collect();
@@ -787,7 +789,7 @@ mod tests {
         let mut topless = whole.clone();
         topless.drain(58..60);
         let (solver, _) = step_beside_one_writing_every_point(bodies, [&whole, &topless], 6);
-        assert_eq!(solver.steps_planned_first, 0);
+        assert_eq!(solver.stats.soft_steps_planned_first, 0);
     }
 
     /// A step whose contacts join other bodies than the last step's, as many of them and
@@ -834,7 +836,7 @@ mod tests {
                 step_falling(&mut fresh, &mut bodies_fresh, first);
             }
             assert!(
-                unchecked.steps_skipping.0 > 0,
+                unchecked.stats.soft_steps_skipping_points > 0,
                 "no lane was filled unwritten"
             );
             let first_grouping = unchecked.contact_grouping.grouped().to_vec();

@@ -154,12 +154,9 @@ impl SoftStepSolver {
             );
         stage_clock::record(Stage::PreparingPlan, started);
         let rebuild = skipped && (!kept || self.may_bounce);
-        #[cfg(test)]
-        {
-            self.steps_skipping.0 += usize::from(skipped);
-            self.steps_skipping.1 += usize::from(rebuild);
-            self.steps_planned_first += usize::from(planned_first);
-        }
+        self.stats.soft_steps_skipping_points += u64::from(skipped);
+        self.stats.soft_steps_rebuilding_points += u64::from(rebuild);
+        self.stats.soft_steps_planned_first += u64::from(planned_first);
         if rebuild {
             // The plan changed after all, or something bounces (restitution reads every
             // point): every point is built again, and written. The LCP islands' points
