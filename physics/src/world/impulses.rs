@@ -4,11 +4,12 @@
 
 use super::{MAX_SUBSTEPS, World};
 use crate::body::Body;
-use crate::solver::ImpulseMethod;
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
+use crate::solver::joint::{JointBlockSolver, JointConstraint, JointIterations};
 use crate::solver::simultaneous::FrictionModel;
 use crate::solver::system::VelocityTargets;
+use crate::solver::{ImpulseMethod, SolverBody};
 
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
 /// at once overshoots in stacks, where pushes add up along the column.
@@ -110,27 +111,37 @@ impl World {
 
     /// Broken joints move towards closing, by positions only.
     pub(super) fn repair_broken_joints(&mut self, dt: f64) {
-        if self.joints.is_empty() {
-            return;
-        }
-        self.gather_solver_bodies();
-        let it = self.settings.joint_iterations(dt);
-        let s = &mut self.scratch;
-        s.joint_solver
-            .repair_positions(&mut s.joint_constraints, &mut s.solver_bodies, &it);
-        self.scatter_solver_bodies();
+        self.joint_pass(dt, JointBlockSolver::repair_positions);
     }
 
     /// Stage 1: joints whose anchors drift apart stop drifting (SPEC eq. 40).
     pub(super) fn correct_joint_velocities(&mut self, dt: f64) {
+        self.joint_pass(dt, JointBlockSolver::correct_velocities);
+    }
+
+    /// A pass of the joints alone over the bodies gathered for it, if there are joints.
+    fn joint_pass(
+        &mut self,
+        dt: f64,
+        pass: fn(
+            &mut JointBlockSolver,
+            &mut [JointConstraint],
+            &mut [SolverBody],
+            &JointIterations,
+        ),
+    ) {
         if self.joints.is_empty() {
             return;
         }
         self.gather_solver_bodies();
         let it = self.settings.joint_iterations(dt);
         let s = &mut self.scratch;
-        s.joint_solver
-            .correct_velocities(&mut s.joint_constraints, &mut s.solver_bodies, &it);
+        pass(
+            &mut s.joint_solver,
+            &mut s.joint_constraints,
+            &mut s.solver_bodies,
+            &it,
+        );
         self.scatter_solver_bodies();
     }
 

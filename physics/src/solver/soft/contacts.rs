@@ -2,7 +2,7 @@
 //! the same arithmetic the batches run lane by lane.
 
 use super::batch::PassSettings;
-use super::{PointConstraint, SoftBody};
+use super::{NormalBlock, PointConstraint, SoftBody};
 use crate::math::{Rot, Vec2, clamp, cross, greater, lesser, perp};
 
 /// Re-applies a point's accumulated impulses at the start of a substep.
@@ -298,19 +298,8 @@ pub(super) fn solve_normal_pair(
     let (k11, k12, k22) = (block.k11, block.k12, block.k22);
     // Each product added to another rounded once (`f64::mul_add`), as the lanes do.
     let (kx1, kx2) = (k12.mul_add(x2, k11 * x1), k22.mul_add(x2, k12 * x1));
-    let (r1, r2) = ((v1 - tp) - kx1, (v2 - tq) - kx2);
-    let (i11, i12, i22) = block.inverse;
-    let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
-    let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
-    let totals = if both.0 >= 0.0 && both.1 >= 0.0 {
-        both
-    } else if first >= 0.0 && k12.mul_add(first, r2) >= 0.0 {
-        (first, 0.0)
-    } else if second >= 0.0 && k12.mul_add(second, r1) >= 0.0 {
-        (0.0, second)
-    } else {
-        (0.0, 0.0) // r ≥ 0 is the only case left for a positive definite K
-    };
+    let r = ((v1 - tp) - kx1, (v2 - tq) - kx2);
+    let totals = two_row_lcp(&block, r, (p.normal_mass, q.normal_mass));
     apply_normal(pair, p, totals.0);
     apply_normal(pair, q, totals.1);
 }
@@ -325,11 +314,22 @@ pub(super) fn push_to_floors(
     (r1, r2): (f64, f64),
 ) {
     let block = p.pair_coupling.expect("paired points");
+    let pushes = two_row_lcp(&block, (r1, r2), (p.normal_mass, q.normal_mass));
+    apply_normal(pair, p, p.normal_impulse + pushes.0);
+    apply_normal(pair, q, q.normal_impulse + pushes.1);
+}
+
+/// x ≥ 0 with w = K x + r ≥ 0 and x·w = 0 for a manifold's two rows, K its normal
+/// `block` (`normal_masses` = 1 / k₁₁, 1 / k₂₂), by trying the four active sets: both
+/// rows pushed, the first alone, the second alone, neither (r ≥ 0 is the only case left
+/// for a positive definite K).
+#[inline(always)]
+fn two_row_lcp(block: &NormalBlock, (r1, r2): (f64, f64), normal_masses: (f64, f64)) -> (f64, f64) {
     let (i11, i12, i22) = block.inverse;
     let k12 = block.k12;
     let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
-    let (first, second) = (-r1 * p.normal_mass, -r2 * q.normal_mass);
-    let pushes = if both.0 >= 0.0 && both.1 >= 0.0 {
+    let (first, second) = (-r1 * normal_masses.0, -r2 * normal_masses.1);
+    if both.0 >= 0.0 && both.1 >= 0.0 {
         both
     } else if first >= 0.0 && k12.mul_add(first, r2) >= 0.0 {
         (first, 0.0)
@@ -337,7 +337,5 @@ pub(super) fn push_to_floors(
         (0.0, second)
     } else {
         (0.0, 0.0)
-    };
-    apply_normal(pair, p, p.normal_impulse + pushes.0);
-    apply_normal(pair, q, q.normal_impulse + pushes.1);
+    }
 }

@@ -230,6 +230,20 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         if !((below1 ^ below2) ^ (below1 & below2)).any() {
             return;
         }
+        let [push1, push2] = self.two_row_lcp([r1, r2]);
+        let points = self.points.iter().zip(&mut self.normal_impulses);
+        for (((p, impulse), bounce), push) in points.zip(&mut self.bounce).zip([push1, push2]) {
+            let total = *impulse + push;
+            apply_normal(pair, (p, impulse), BOUNCE.then_some(bounce), normal, total);
+        }
+    }
+
+    /// `two_row_lcp` (contacts.rs) on every lane: x ≥ 0 with w = K x + r ≥ 0 and
+    /// x·w = 0 for the manifold's two rows, the active set of each lane chosen by masks.
+    #[inline(always)]
+    fn two_row_lcp(&self, [r1, r2]: [L; 2]) -> [L; 2] {
+        let zero = L::splat(0.0);
+        let points = &self.points[..];
         let [i11, i12, i22] = self.inverse;
         let k12 = self.k12;
         let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
@@ -238,16 +252,13 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         let take_both = both.0.ge(zero) & both.1.ge(zero);
         let take_first = first.ge(zero) & k12.mul_add(first, r2).ge(zero);
         let take_second = second.ge(zero) & k12.mul_add(second, r1).ge(zero);
-        let push1 = take_both.select(both.0, take_first.select(first, zero));
-        let push2 = take_both.select(
-            both.1,
-            take_first.select(zero, take_second.select(second, zero)),
-        );
-        let points = self.points.iter().zip(&mut self.normal_impulses);
-        for (((p, impulse), bounce), push) in points.zip(&mut self.bounce).zip([push1, push2]) {
-            let total = *impulse + push;
-            apply_normal(pair, (p, impulse), BOUNCE.then_some(bounce), normal, total);
-        }
+        [
+            take_both.select(both.0, take_first.select(first, zero)),
+            take_both.select(
+                both.1,
+                take_first.select(zero, take_second.select(second, zero)),
+            ),
+        ]
     }
 
     /// Both points' normal velocities, their approach where they may bounce, and the
@@ -279,24 +290,10 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         [v1, v2]: [L; 2],
         [t1, t2]: [L; 2],
     ) {
-        let zero = L::splat(0.0);
-        let points = &self.points[..];
         let [x1, x2] = [self.normal_impulses[0], self.normal_impulses[1]];
         let (k11, k12, k22) = (self.k11, self.k12, self.k22);
         let (kx1, kx2) = (k12.mul_add(x2, k11 * x1), k22.mul_add(x2, k12 * x1));
-        let (r1, r2) = ((v1 - t1) - kx1, (v2 - t2) - kx2);
-        let [i11, i12, i22] = self.inverse;
-        let both = (-(i12.mul_add(r2, i11 * r1)), -(i22.mul_add(r2, i12 * r1)));
-        let first = -r1 * points[0].normal_mass;
-        let second = -r2 * points[1].normal_mass;
-        let take_both = both.0.ge(zero) & both.1.ge(zero);
-        let take_first = first.ge(zero) & k12.mul_add(first, r2).ge(zero);
-        let take_second = second.ge(zero) & k12.mul_add(second, r1).ge(zero);
-        let total1 = take_both.select(both.0, take_first.select(first, zero));
-        let total2 = take_both.select(
-            both.1,
-            take_first.select(zero, take_second.select(second, zero)),
-        );
+        let [total1, total2] = self.two_row_lcp([(v1 - t1) - kx1, (v2 - t2) - kx2]);
         let normal = (self.normal_x, self.normal_y);
         let points = self.points.iter().zip(&mut self.normal_impulses);
         for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
