@@ -57,24 +57,48 @@ fn click_world(h: &mut Harness<'_, RoboSimApp>, x: f64, y: f64, modifiers: Modif
 
 /// Drags on the canvas with the primary button from world point `from` to `to`.
 fn drag_world(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64)) {
+    drag_world_holding(h, from, to, Modifiers::NONE);
+}
+
+/// `drag_world` with `modifiers` held (Shift adds a rubber band's bodies to the
+/// selection).
+fn drag_world_holding(
+    h: &mut Harness<'_, RoboSimApp>,
+    from: (f64, f64),
+    to: (f64, f64),
+    modifiers: Modifiers,
+) {
     let app = h.state();
     let screen = |(x, y): (f64, f64)| {
         app.camera()
             .to_screen(app.canvas_rect(), pe::Vec2::new(x, y))
     };
     let (start, end) = (screen(from), screen(to));
-    drag_screen(h, start, end, 4);
+    drag_screen_holding(h, start, end, 4, modifiers);
 }
 
-/// Drags with the primary button from screen point `start` to `end` in `moves` frames.
+/// Drags with the primary button from screen point `start` to `end` in `moves` frames,
+/// no modifier held.
 fn drag_screen(h: &mut Harness<'_, RoboSimApp>, start: Pos2, end: Pos2, moves: usize) {
+    drag_screen_holding(h, start, end, moves, Modifiers::NONE);
+}
+
+/// `drag_screen` with `modifiers` held from the press to the release.
+fn drag_screen_holding(
+    h: &mut Harness<'_, RoboSimApp>,
+    start: Pos2,
+    end: Pos2,
+    moves: usize,
+    modifiers: Modifiers,
+) {
+    h.event(Event::ModifiersChanged(modifiers));
     h.event(Event::PointerMoved(start));
     h.run_steps(1);
     let button = |pos, pressed| Event::PointerButton {
         pos,
         button: PointerButton::Primary,
         pressed,
-        modifiers: Modifiers::NONE,
+        modifiers,
     };
     h.event(button(start, true));
     h.run_steps(1);
@@ -372,6 +396,13 @@ fn dragging_and_turning_a_body_at_step_0_edits_its_placement_in_the_scene() {
 }
 
 /// Pauses the selected scene at step 0, where the canvas edits it.
+/// Opens `scene` and resets it to step 0, where placements can be selected and edited.
+fn open_at_step_0(h: &mut Harness<'_, RoboSimApp>, scene: &str) {
+    h.get_by_label(scene).click();
+    h.run_steps(2);
+    stop_at_step_0(h);
+}
+
 fn stop_at_step_0(h: &mut Harness<'_, RoboSimApp>) {
     if h.state().is_running() {
         click(h, "Pause");
@@ -384,9 +415,7 @@ fn stop_at_step_0(h: &mut Harness<'_, RoboSimApp>) {
 fn ctrl_s_saves_without_stepping_the_simulation() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    h.get_by_label("stack of boxes").click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    open_at_step_0(&mut h, "stack of boxes");
     type_into(&mut h, "gravitation", "150");
     h.key_press_modifiers(Modifiers::COMMAND, Key::S);
     h.run_steps(2);
@@ -879,9 +908,7 @@ fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() 
         .with_size(egui::vec2(1280.0, 800.0))
         .build_eframe(move |_| app);
     h.run_steps(3);
-    h.get_by_label("stack of boxes").click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    open_at_step_0(&mut h, "stack of boxes");
     let scene =
         |h: &Harness<'_, RoboSimApp>| h.state().model().scene("stack of boxes").unwrap().clone();
     let count = scene(&h).bodies.len();

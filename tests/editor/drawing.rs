@@ -1,7 +1,7 @@
 //! The drawing tools: a box or a regular polygon dragged out on the canvas becomes a new
 //! body definition placed where it was drawn, in a scene or a robot, as one undo step.
 
-use super::{drag_world, harness, scratch_db, stop_at_step_0};
+use super::{drag_world, harness, open_at_step_0, scratch_db};
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -16,9 +16,7 @@ fn undo(h: &mut Harness<'_, RoboSimApp>) {
 fn a_box_dragged_into_a_scene_is_a_new_body_placed_there_and_one_undo_takes_both() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    h.get_by_label("stack of boxes").click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    open_at_step_0(&mut h, "stack of boxes");
     let before = h.state().model().clone();
     h.key_press(Key::B);
     h.run_steps(2);

@@ -1,7 +1,7 @@
 //! File → Export run as GIF…: the run shown, from step 0, as an animated GIF written on a
 //! thread of its own.
 
-use super::{scratch_db, stop_at_step_0};
+use super::{open_at_step_0, scratch_db};
 use egui::Key;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -34,9 +34,7 @@ fn the_run_shown_exports_as_a_gif_from_step_0_to_the_step_shown() {
         .with_size(egui::vec2(1280.0, 800.0))
         .build_eframe(move |_| app);
     h.run_steps(3);
-    h.get_by_label("stack of boxes").click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    open_at_step_0(&mut h, "stack of boxes");
     // 30 steps of 1/60 s: the ball falls 25 px. Frames every 2 steps: 0, 2, …, 30.
     for _ in 0..30 {
         h.key_press(Key::S);

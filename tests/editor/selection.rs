@@ -1,12 +1,13 @@
 //! Rubber-band selection at step 0 and the edits that apply to every selected placement
 //! at once, each one undo step.
 
-use super::{click_world, drag_world, harness, scratch_db, stop_at_step_0};
-use egui::{Event, Key, Modifiers, PointerButton};
+use super::{click_world, drag_world, drag_world_holding, harness, open_at_step_0, scratch_db};
+use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use robosim::app::RoboSimApp;
 use robosim::model::{Placement, Scene};
+use std::path::Path;
 
 const STACK: &str = "stack of boxes";
 
@@ -16,6 +17,14 @@ fn stack(h: &Harness<'_, RoboSimApp>) -> Scene {
 
 fn body<'s>(scene: &'s Scene, alias: &str) -> &'s Placement {
     scene.bodies.iter().find(|b| b.alias == alias).unwrap()
+}
+
+/// The app on a copy of the default database in `dir`, with the stack of boxes open and
+/// reset to step 0, where placements can be selected and edited.
+fn stack_at_step_0(dir: &Path) -> Harness<'static, RoboSimApp> {
+    let mut h = harness(dir);
+    open_at_step_0(&mut h, STACK);
+    h
 }
 
 /// The trace ids of the selected bodies, sorted.
@@ -33,33 +42,7 @@ fn picked_ids(h: &Harness<'_, RoboSimApp>) -> Vec<String> {
 
 /// Drags a rubber band from world point `from` to `to`, with `modifiers` held.
 fn band(h: &mut Harness<'_, RoboSimApp>, from: (f64, f64), to: (f64, f64), modifiers: Modifiers) {
-    let app = h.state();
-    let screen = |(x, y): (f64, f64)| {
-        app.camera()
-            .to_screen(app.canvas_rect(), pe::Vec2::new(x, y))
-    };
-    let (start, end) = (screen(from), screen(to));
-    h.event(Event::ModifiersChanged(modifiers));
-    h.event(Event::PointerMoved(start));
-    h.run_steps(1);
-    let button = |pos, pressed| Event::PointerButton {
-        pos,
-        button: PointerButton::Primary,
-        pressed,
-        modifiers,
-    };
-    h.event(button(start, true));
-    h.run_steps(1);
-    for k in 1..=4 {
-        h.event(Event::PointerMoved(
-            start + (end - start) * (k as f32 / 4.0),
-        ));
-        h.run_steps(1);
-    }
-    h.event(button(end, false));
-    h.run_steps(2);
-    h.event(Event::ModifiersChanged(Modifiers::NONE));
-    h.run_steps(1);
+    drag_world_holding(h, from, to, modifiers);
 }
 
 /// Boxes 2, 3 and 4 of the stack (30 × 30 at x = 400, y = 335, 305, 275): a band from
@@ -77,10 +60,7 @@ fn undo(h: &mut Harness<'_, RoboSimApp>) {
 #[test]
 fn a_rubber_band_selects_what_it_touches_and_shift_adds() {
     let dir = scratch_db();
-    let mut h = harness(dir.path());
-    h.get_by_label(STACK).click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    let mut h = stack_at_step_0(dir.path());
     pick_three(&mut h);
     h.get_by_label("3 items selected");
     // Shift adds the ball (a circle-like polygon about (250, 100)).
@@ -102,10 +82,7 @@ fn a_rubber_band_selects_what_it_touches_and_shift_adds() {
 #[test]
 fn delete_nudge_drag_and_turn_apply_to_the_whole_selection_as_one_undo_step() {
     let dir = scratch_db();
-    let mut h = harness(dir.path());
-    h.get_by_label(STACK).click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    let mut h = stack_at_step_0(dir.path());
     let before = h.state().model().clone();
     let count = stack(&h).bodies.len();
 
@@ -171,10 +148,7 @@ fn delete_nudge_drag_and_turn_apply_to_the_whole_selection_as_one_undo_step() {
 #[test]
 fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
     let dir = scratch_db();
-    let mut h = harness(dir.path());
-    h.get_by_label(STACK).click();
-    h.run_steps(2);
-    stop_at_step_0(&mut h);
+    let mut h = stack_at_step_0(dir.path());
     let before = h.state().model().clone();
     let count = stack(&h).bodies.len();
 
