@@ -2,15 +2,26 @@
 //! (x, y up) becomes (x, −y) here.
 
 use crate::Outcome;
-use crate::harness::measure;
+use crate::harness::{ProfileLog, measure};
 use crate::scene::{
     BOB, BOX, BoxPose, FLOOR, FRICTION, G, H, Metric, Pendulum, PeriodTracker, Pyramid,
     PyramidTracker, ReboundTracker, SmashTracker, bounce, chain, joint_grid, smash, worst,
 };
 use pe::{
     BodyDef, BodyHandle, ContactSolver, ConvexPolygon, Integrator, JointDef, JointHandle,
-    StepSettings, Vec2, World,
+    StepProfile, StepSettings, Vec2, World,
 };
+
+/// pe's own timing of each step (its stage clock), for `pe ... stages` and `stages`.
+pub static PROFILES: ProfileLog<StepProfile> = ProfileLog::new();
+
+/// One step, its profile kept if asked (`PROFILES`).
+fn step(w: &mut World, h: f64) {
+    w.step(h);
+    if PROFILES.keeping() {
+        PROFILES.push(*w.profile());
+    }
+}
 
 /// How pe is set up for a run: the contact solver, the integrator, the soft step's
 /// substeps and sweep order (used by `soft` only), and whether the narrow phase reuses
@@ -95,7 +106,7 @@ pub fn pyramid(config: PeConfig, spec: &Pyramid, h: f64) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps,
-        |w| w.step(h),
+        |w| step(w, h),
         |w, _| tracker.update(boxes.iter().map(|&b| centre(w, b))),
     );
     Outcome::new(timing, tracker.finish())
@@ -115,7 +126,7 @@ pub fn pendulum(config: PeConfig, spec: &Pendulum) -> Outcome {
     let timing = measure(
         &mut w,
         spec.steps(),
-        |w| w.step(h),
+        |w| step(w, h),
         |w, n| {
             let gap = w.joint_gap(pin).expect("joints are never removed");
             tracker.update(n, centre(w, bob).0, energy(w), gap);
@@ -146,7 +157,7 @@ pub fn heavy_chain(config: PeConfig, h: f64) -> Outcome {
     let timing = measure(
         &mut w,
         chain::steps(h),
-        |w| w.step(h),
+        |w| step(w, h),
         |w, _| {
             for &j in &joints {
                 worst_gap = worst(worst_gap, w.joint_gap(j).expect("joints are never removed"));
@@ -168,7 +179,7 @@ pub fn bounce(config: PeConfig, h: f64) -> Outcome {
     let timing = measure(
         &mut w,
         bounce::steps(h),
-        |w| w.step(h),
+        |w| step(w, h),
         |w, _| {
             let v_up = -w.body(body).expect("live").velocity.y;
             tracker.update(centre(w, body).1 - half, v_up);
@@ -206,7 +217,7 @@ pub fn smash(config: PeConfig) -> Outcome {
     let timing = measure(
         &mut w,
         smash::STEPS,
-        |w| w.step(H),
+        |w| step(w, H),
         |w, _| tracker.update(momentum(w), w.kinetic_energy(), smash_poses(w)),
     );
     Outcome::new(timing, tracker.finish())
@@ -238,7 +249,7 @@ pub fn joint_grid(config: PeConfig) -> Outcome {
     let timing = measure(
         &mut w,
         joint_grid::STEPS,
-        |w| w.step(H),
+        |w| step(w, H),
         |w, _| {
             for &j in &pins {
                 worst_gap = worst(worst_gap, w.joint_gap(j).expect("joints are never removed"));

@@ -6,7 +6,7 @@ use crate::piles::{pile_jobs, pile_scenes};
 use crate::scene::{H, PYRAMIDS, joint_grid, smash};
 use crate::{box2d_scenes, harness, pe_scenes, rapier_scenes};
 use pe::ContactSolver;
-use pe::stage_clock::Stage;
+use pe::Stage;
 use pe_scenes::PeConfig;
 
 /// `pe <scene> [solver] [fresh] [forwards] [substeps=S] [steps=N] [stages [from=K]]`: one
@@ -29,6 +29,14 @@ pub fn run_pe_alone() {
         .find_map(|f| f.strip_prefix("steps=")?.parse().ok())
     {
         harness::fixed_steps(steps);
+    }
+    let stages = flags.iter().any(|f| f == "stages");
+    if stages {
+        if !cfg!(feature = "stages") {
+            eprintln!("stages: build with `--features stages` to count them");
+            std::process::exit(2);
+        }
+        pe_scenes::PROFILES.keep();
     }
     let defaults = PeConfig::new(solver);
     let config = PeConfig {
@@ -54,7 +62,7 @@ pub fn run_pe_alone() {
         std::process::exit(2);
     };
     println!("{scene} under pe {}: {outcome:?}", solver.name());
-    if flags.iter().any(|f| f == "stages") {
+    if stages {
         let from = flags
             .iter()
             .find_map(|f| f.strip_prefix("from=")?.parse().ok());
@@ -63,14 +71,9 @@ pub fn run_pe_alone() {
 }
 
 /// The table of `pe <scene> ... stages`: each stage's fewest and median cycles a step over
-/// the steps from `from` on (half way by default), from `pe::stage_clock`.
+/// the steps from `from` on (half way by default), from pe's profiles (`World::profile`).
 fn print_stage_cycles(from: Option<usize>) {
-    use pe::stage_clock;
-    if !cfg!(feature = "stages") {
-        eprintln!("stages: build with `--features stages` to count them");
-        std::process::exit(2);
-    }
-    let steps = stage_clock::take_steps();
+    let steps: Vec<_> = pe_scenes::PROFILES.take().iter().map(|p| p.ticks).collect();
     let from = from.unwrap_or(steps.len() / 2).min(steps.len());
     let counted = &steps[from..];
     if counted.is_empty() {
@@ -98,9 +101,8 @@ fn print_stage_cycles(from: Option<usize>) {
 /// K-th (half way by default), the stages matched as closely as the steps allow (a row
 /// with no stage of an engine reads 0: that engine times it within another row). The peers
 /// time their stages with the wall clock, pe with its stage clock, converted at the rate
-/// `stage_clock::ticks_per_microsecond` measures.
+/// `pe::ticks_per_microsecond` measures.
 pub fn run_stages_beside_peers() {
-    use pe::stage_clock;
     let args: Vec<String> = std::env::args().skip(2).collect();
     let scene = args.first().cloned().unwrap_or_default();
     let Some(mut jobs) = pile_jobs(&scene) else {
@@ -121,9 +123,10 @@ pub fn run_stages_beside_peers() {
     // `pile_jobs`: pe `soft`, rapier2d, Box2D v3.
     let box2d_job = jobs.pop().expect("Box2D v3's job");
     let rapier_job = jobs.pop().expect("rapier2d's job");
+    pe_scenes::PROFILES.keep();
     let pe_run = jobs.swap_remove(0)();
-    let pe_steps = stage_clock::take_steps();
-    let ticks_per_microsecond = stage_clock::ticks_per_microsecond().expect("enabled");
+    let pe_steps: Vec<_> = pe_scenes::PROFILES.take().iter().map(|p| p.ticks).collect();
+    let ticks_per_microsecond = pe::ticks_per_microsecond().expect("enabled");
     rapier_scenes::PROFILES.keep();
     rapier_job();
     let rapier = rapier_scenes::PROFILES.take();

@@ -32,9 +32,10 @@
 //! - Geometry: [`Vec2`] (nalgebra's), [`Aabb`], [`convex_hull`], and the separating-axis
 //!   test the step finds contacts by, on polygons placed in the world ([`collide_polygons`]
 //!   on [`WorldPolygon`]s), by which the benchmark judges every engine's overlaps.
-//! - Profiling: the cycles of each stage of a step ([`stage_clock`], counted with the
-//!   feature `stage-clock` only) and the SIMD path the soft step takes
-//!   ([`lane_path_name`]).
+//! - Profiling: the cycles each [`Stage`] of a world's last step took
+//!   ([`World::profile`], a [`StepProfile`], turned into time by
+//!   [`ticks_per_microsecond`]; counted with the feature `stage-clock` only) and the SIMD
+//!   path the soft step takes ([`lane_path_name`]).
 
 mod body;
 mod collide;
@@ -42,7 +43,7 @@ pub mod limits;
 mod math;
 mod shape;
 mod solver;
-pub mod stage_clock;
+mod stage_clock;
 mod world;
 
 pub use crate::{
@@ -58,6 +59,7 @@ pub use crate::{
         simultaneous::{IslandMethod, IslandReport},
         soft::lane_path_name,
     },
+    stage_clock::{Stage, StepProfile, ticks_per_microsecond},
     world::{
         FALL_PER_STEP, JointDef, JointError, StepError, World,
         settings::{Integrator, StepSettings},

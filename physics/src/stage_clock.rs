@@ -1,7 +1,7 @@
-//! Cycles spent in each stage of a step, for profiling. With the feature `stage-clock`
-//! each stage is timed by the processor's time-stamp counter (`rdtsc` on x86-64,
-//! nanoseconds elsewhere) and every step's counts are kept; without it every function here
-//! is empty and compiles away.
+//! Cycles spent in each stage of a world's last step (`World::profile`), for profiling.
+//! With the feature `stage-clock` each stage is timed by the processor's time-stamp
+//! counter (`rdtsc` on x86-64, nanoseconds elsewhere); without it every function here is
+//! empty and compiles away, and every profile reads zero.
 //!
 //! Why not wall-clock medians: on a shared machine those drift by tens of percent, while
 //! the fewest cycles a stage took over many steps of one run move by 1–2%, which is what a
@@ -98,20 +98,6 @@ pub(crate) struct Mark(#[cfg(feature = "stage-clock")] u64);
 
 #[cfg(feature = "stage-clock")]
 mod counting {
-    use super::Stage;
-    use std::sync::Mutex;
-
-    /// This step's counts so far, and every finished step's, across the process.
-    pub(super) struct Counts {
-        pub current: [u64; Stage::ALL.len()],
-        pub steps: Vec<[u64; Stage::ALL.len()]>,
-    }
-
-    pub(super) static COUNTS: Mutex<Counts> = Mutex::new(Counts {
-        current: [0; Stage::ALL.len()],
-        steps: Vec::new(),
-    });
-
     #[inline(always)]
     pub(super) fn now() -> u64 {
         #[cfg(target_arch = "x86_64")]
@@ -142,41 +128,44 @@ pub(crate) fn mark() -> Mark {
     }
 }
 
-/// Adds the time since `since` to `stage`'s count for this step; `Stage::Step` ends the
-/// step, keeping its counts.
-#[inline(always)]
-pub(crate) fn record(stage: Stage, since: Mark) {
-    #[cfg(feature = "stage-clock")]
-    {
-        let elapsed = counting::now().wrapping_sub(since.0);
-        let mut counts = counting::COUNTS.lock().unwrap_or_else(|e| e.into_inner());
-        counts.current[stage as usize] += elapsed;
-        if stage == Stage::Step {
-            let finished = std::mem::take(&mut counts.current);
-            counts.steps.push(finished);
-        }
-    }
-    #[cfg(not(feature = "stage-clock"))]
-    let _ = (stage, since);
+/// The clock's ticks each stage of a step took, by `Stage::ALL`'s order: read the last
+/// step's with `World::profile`, turned into time by `ticks_per_microsecond`. All zero
+/// without the feature `stage-clock`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct StepProfile {
+    pub ticks: [u64; Stage::ALL.len()],
 }
 
-/// Every finished step's counts since the last call, by `Stage::ALL`'s order (none
-/// without the feature).
-pub fn take_steps() -> Vec<[u64; Stage::ALL.len()]> {
-    #[cfg(feature = "stage-clock")]
-    {
-        let mut counts = counting::COUNTS.lock().unwrap_or_else(|e| e.into_inner());
-        std::mem::take(&mut counts.steps)
+impl StepProfile {
+    /// Adds the time since `since` to `stage`'s count.
+    #[inline(always)]
+    pub(crate) fn record(&mut self, stage: Stage, since: Mark) {
+        #[cfg(feature = "stage-clock")]
+        {
+            self.ticks[stage as usize] += counting::now().wrapping_sub(since.0);
+        }
+        #[cfg(not(feature = "stage-clock"))]
+        let _ = (stage, since);
     }
-    #[cfg(not(feature = "stage-clock"))]
-    {
-        Vec::new()
+
+    /// `other`'s counts added to these, and `other` set to zero: a solver's own profile
+    /// handed to its world's.
+    #[inline(always)]
+    pub(crate) fn take_from(&mut self, other: &mut StepProfile) {
+        #[cfg(feature = "stage-clock")]
+        {
+            for (mine, theirs) in self.ticks.iter_mut().zip(&mut other.ticks) {
+                *mine += std::mem::take(theirs);
+            }
+        }
+        #[cfg(not(feature = "stage-clock"))]
+        let _ = other;
     }
 }
 
 /// How many of the clock's ticks pass in a microsecond (the time-stamp counter's rate on
 /// x86-64; about 1,000 elsewhere, where it counts nanoseconds), measured against the wall
-/// clock over a tenth of a second: to turn `take_steps`' counts into time. `None` without
+/// clock over a tenth of a second: to turn a `StepProfile`'s ticks into time. `None` without
 /// the feature.
 pub fn ticks_per_microsecond() -> Option<f64> {
     #[cfg(feature = "stage-clock")]
@@ -193,17 +182,15 @@ pub fn ticks_per_microsecond() -> Option<f64> {
     }
 }
 
-/// Run alone (`cargo test -p pe --features stage-clock --lib stage_clock`, as CI does): the
-/// counts are the process's, and other tests stepping worlds at the same time would add
-/// theirs.
+/// Run by CI with the feature (`cargo test -p pe --features stage-clock --lib stage_clock`).
 #[cfg(all(test, feature = "stage-clock"))]
 mod tests {
     use super::*;
     use crate::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
 
-    /// A box resting on a floor under the soft step, three steps: three steps counted,
-    /// every stage took time, the stages, which lie inside the step, add up to less, and
-    /// the parts of a stage to no more than it.
+    /// A box resting on a floor under the soft step, three steps: every stage of each
+    /// step took time, the stages, which lie inside the step, add up to less, and the
+    /// parts of a stage to no more than it; a world's profile is its own.
     #[test]
     fn each_step_counts_its_stages() {
         let mut w = World::new(Vec2::new(0.0, 10.0));
@@ -214,13 +201,13 @@ mod tests {
         let square = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
         w.add_body(BodyDef::new(square, 1.0).at(Vec2::new(0.0, 0.0), 0.0))
             .unwrap();
-        take_steps();
+        assert_eq!(*w.profile(), StepProfile::default(), "no step yet");
+        let mut other = w.clone();
+        other.settings.contact_solver = ContactSolver::Exact;
         for _ in 0..3 {
             w.step(1.0 / 60.0);
-        }
-        let steps = take_steps();
-        assert_eq!(steps.len(), 3);
-        for counts in steps {
+            other.step(1.0 / 60.0);
+            let counts = w.profile().ticks;
             assert!(counts.iter().all(|&c| c > 0), "{counts:?}");
             let parts_of = |whole: Option<Stage>| -> u64 {
                 let parts = Stage::ALL[1..].iter().filter(|s| s.within() == whole);
@@ -229,6 +216,10 @@ mod tests {
             assert!(parts_of(None) < counts[Stage::Step as usize], "{counts:?}");
             let preparing = counts[Stage::Preparing as usize];
             assert!(parts_of(Some(Stage::Preparing)) <= preparing, "{counts:?}");
+            // The exact step has no soft stages: none of the soft world's reached it.
+            let exact = other.profile().ticks;
+            assert_eq!(exact[Stage::Preparing as usize], 0, "{exact:?}");
+            assert!(exact[Stage::Step as usize] > 0, "{exact:?}");
         }
     }
 

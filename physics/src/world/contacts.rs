@@ -38,7 +38,7 @@ impl World {
         if !std::mem::take(&mut self.scratch.candidates_current) {
             self.find_candidate_pairs(dt);
         }
-        stage_clock::record(Stage::BroadPhase, started);
+        self.profile.record(Stage::BroadPhase, started);
         let started = stage_clock::mark();
         let s = &mut self.scratch;
         let margin = self.settings.contact_margin();
@@ -83,7 +83,7 @@ impl World {
                 cache.store(m, (pose_a, pose_b), pair_margin);
             }
         }
-        stage_clock::record(Stage::NarrowPhase, started);
+        self.profile.record(Stage::NarrowPhase, started);
         let started = stage_clock::mark();
         self.drop_idle_manifolds(margin);
         for m in &self.manifolds {
@@ -129,7 +129,7 @@ impl World {
                 });
             }
         }
-        stage_clock::record(Stage::Contacts, started);
+        self.profile.record(Stage::Contacts, started);
     }
 
     /// Drops the speculative manifolds that cannot act this step: every point farther off

@@ -16,7 +16,7 @@ use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::simultaneous::IslandReport;
 use crate::math::{Rot, Vec2};
-use crate::stage_clock::{self, Stage};
+use crate::stage_clock::{self, Stage, StepProfile};
 use crate::world::stats::StepStats;
 use batch::{LanePath, PassPlan, PassSettings, PlanInput};
 use pins::PinPlan;
@@ -410,6 +410,8 @@ pub(crate) struct SoftStepSolver {
     pub(crate) write_every_point: bool,
     /// The soft step's part of the world's `StepStats`.
     pub(crate) stats: StepStats,
+    /// The soft step's stages of this world step, handed to the world's profile.
+    pub(crate) profile: StepProfile,
 }
 
 /// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
@@ -496,7 +498,7 @@ impl SoftStepSolver {
         );
         let started = stage_clock::mark();
         self.prepare(bodies, accelerations, contacts, joints, dt);
-        stage_clock::record(Stage::Preparing, started);
+        self.profile.record(Stage::Preparing, started);
         let sweep_order = |substep: u64| {
             if settings.alternating_sweeps {
                 SweepOrder::of_substep(substep)
@@ -521,14 +523,14 @@ impl SoftStepSolver {
                 // level-2 cache, where asking only costs (many_pyramids' solve 7% slower).
                 let ask = substep == 0;
                 self.warm_start_items(items.clone(), ask);
-                stage_clock::record(Stage::WarmStart, started);
+                self.profile.record(Stage::WarmStart, started);
                 let started = stage_clock::mark();
                 self.sweep_items(items.clone(), &pass(true), order, ask);
                 for &i in self.plan.chunk(k).1 {
                     integrate_position(&mut self.bodies[i as usize], h);
                 }
                 self.sweep_items(items.clone(), &pass(false), order, false);
-                stage_clock::record(Stage::Solve, started);
+                self.profile.record(Stage::Solve, started);
             }
         }
         for _ in 0..settings.substeps {
@@ -537,12 +539,12 @@ impl SoftStepSolver {
             self.integrate_velocities(accelerations, h);
             let started = stage_clock::mark();
             self.warm_start();
-            stage_clock::record(Stage::WarmStart, started);
+            self.profile.record(Stage::WarmStart, started);
             let started = stage_clock::mark();
             self.solve(h, &contact_soft, &joint_soft, settings, true, order);
             self.integrate_positions(h);
             self.solve(h, &contact_soft, &joint_soft, settings, false, order);
-            stage_clock::record(Stage::Solve, started);
+            self.profile.record(Stage::Solve, started);
             // Warm starting re-applies the accumulated impulse in every substep, so the
             // step's total is the sum of the substeps' accumulated values.
             for &k in &self.motor_joints {
@@ -558,7 +560,7 @@ impl SoftStepSolver {
         self.pin_plan.scatter(&mut self.joints);
         let started = stage_clock::mark();
         self.store(bodies, contacts, joints);
-        stage_clock::record(Stage::Storing, started);
+        self.profile.record(Stage::Storing, started);
         self.report();
     }
 }

@@ -25,7 +25,7 @@ impl SoftStepSolver {
         let started = stage_clock::mark();
         self.load_bodies(bodies, joints);
         let (grouping, reused) = self.take_contact_grouping(contacts, bodies.len());
-        stage_clock::record(Stage::PreparingIslands, started);
+        self.profile.record(Stage::PreparingIslands, started);
         self.prepare_points(bodies, accelerations, contacts, dt, (grouping, reused));
         self.prepare_pins(bodies, joints);
     }
@@ -109,7 +109,7 @@ impl SoftStepSolver {
         let planned_first =
             may_plan_first && self.plan_from_contacts(bodies, contacts, grouping.grouped());
         if planned_first {
-            stage_clock::record(Stage::PreparingPlan, started);
+            self.profile.record(Stage::PreparingPlan, started);
         }
         let started = stage_clock::mark();
         // Each manifold goes into the kept plan's lanes as soon as it is complete, and
@@ -137,7 +137,7 @@ impl SoftStepSolver {
                     .expect("the contacts' own grouping")
             }
         };
-        stage_clock::record(Stage::PreparingPoints, started);
+        self.profile.record(Stage::PreparingPoints, started);
         let started = stage_clock::mark();
         self.contact_lcp
             .prepare(&self.bodies, &self.points, &self.contact_islands);
@@ -152,7 +152,7 @@ impl SoftStepSolver {
                 &self.plan_inputs,
                 &self.pinned,
             );
-        stage_clock::record(Stage::PreparingPlan, started);
+        self.profile.record(Stage::PreparingPlan, started);
         let rebuild = skipped && (!kept || self.may_bounce);
         self.stats.soft_steps_skipping_points += u64::from(skipped);
         self.stats.soft_steps_rebuilding_points += u64::from(rebuild);
@@ -167,13 +167,13 @@ impl SoftStepSolver {
             let grouped = (grouping.grouped(), None);
             self.build_points(bodies, accelerations, contacts, grouped, dt)
                 .expect("the contacts' own grouping");
-            stage_clock::record(Stage::PreparingPoints, rebuilt);
+            self.profile.record(Stage::PreparingPoints, rebuilt);
         }
         self.contact_grouping = grouping;
         if !planned_first {
             let started = stage_clock::mark();
             self.plan.plan(&self.points, &self.bodies);
-            stage_clock::record(Stage::PreparingPlan, started);
+            self.profile.record(Stage::PreparingPlan, started);
         }
     }
 
