@@ -3,10 +3,23 @@
 
 use super::World;
 use crate::solver::ImpulseMethod;
+use crate::solver::simultaneous::IslandReport;
 
 /// Seconds an island that went over the exact solver's pivot budget stays on the soft
 /// step under `auto`.
 const SOFT_AFTER_OVER_BUDGET: f64 = 1.0;
+
+/// What `auto` keeps from step to step.
+#[derive(Debug, Clone, Default)]
+pub(super) struct AutoMemory {
+    /// Per body: the step until which its island stays on the soft step
+    /// (`keep_over_budget_on_soft`).
+    soft_until: Vec<u64>,
+    /// The last split of the islands, reused while what it is made from stands.
+    last_marking: LastMarking,
+    /// How the last step's islands were solved, by both passes (`World::island_reports`).
+    pub(super) reports: Vec<IslandReport>,
+}
 
 /// What `auto`'s last marking of soft islands was made from, and what it found: a pile
 /// at rest gives the same step after step (`World::mark_soft_islands`).
@@ -82,9 +95,7 @@ impl World {
         if !soft {
             self.step_impulses(ImpulseMethod::Exact, dt);
             self.keep_over_budget_on_soft(dt);
-            self.scratch
-                .auto_reports
-                .clone_from(&self.scratch.simultaneous.reports);
+            self.auto.reports.clone_from(&self.solvers.exact.reports);
             return;
         }
         if !exact {
@@ -92,9 +103,7 @@ impl World {
             // the candidate pairs just found.
             self.scratch.candidates_current = true;
             self.step_soft(dt);
-            self.scratch
-                .auto_reports
-                .clone_from(&self.scratch.soft.reports);
+            self.auto.reports.clone_from(&self.solvers.soft.reports);
             return;
         }
         self.hold_where(true);
@@ -108,8 +117,10 @@ impl World {
         self.step_soft(dt);
         self.release_held();
         let s = &mut self.scratch;
-        s.auto_reports.clone_from(&s.simultaneous.reports);
-        s.auto_reports.extend_from_slice(&s.soft.reports);
+        self.auto.reports.clone_from(&self.solvers.exact.reports);
+        self.auto
+            .reports
+            .extend_from_slice(&self.solvers.soft.reports);
         // A pair across the two passes (bodies that moved beyond their reach, as gravity
         // adds to the speed the reach was measured with) was found by both: keep the exact
         // pass's.
@@ -155,7 +166,7 @@ impl World {
         // A body motor is a link of the body to itself: no rows, but its island is a
         // robot's.
         links.extend(self.body_motors.iter().map(|(h, _)| (h.0, h.0, 0)));
-        let soft_until = &self.soft_until;
+        let soft_until = &self.auto.soft_until;
         let step = self.step_count;
         s.prefer_soft.clear();
         s.prefer_soft
@@ -164,10 +175,10 @@ impl World {
         // bodies kept on the soft step alone (the fixed ones are `fat_fixed`: no body is
         // held between passes): the same inputs, the same marks, without the union-find.
         let limit = self.settings.dense_row_limit;
-        let last = &s.last_marking;
+        let last = &self.auto.last_marking;
         if let Some(marked) = last.found
             && (&last.links, &last.candidates, &last.fixed, last.row_limit)
-                == (&links, &s.pairs, &s.fat_fixed, limit)
+                == (&links, &s.pairs, &self.kept_pairs.fixed, limit)
             && last.prefer_soft == s.prefer_soft
         {
             s.auto_links = links;
@@ -232,11 +243,11 @@ impl World {
             soft |= in_soft;
             exact |= moving(i) && goes_exact;
         }
-        let last = &mut s.last_marking;
+        let last = &mut self.auto.last_marking;
         // The last links go back to be the buffer for the next marking's.
         std::mem::swap(&mut last.links, &mut s.auto_links);
         last.candidates.clone_from(&s.pairs);
-        last.fixed.clone_from(&s.fat_fixed);
+        last.fixed.clone_from(&self.kept_pairs.fixed);
         last.row_limit = limit;
         last.prefer_soft.clone_from(&s.prefer_soft);
         last.found = Some((exact, soft));
@@ -247,16 +258,16 @@ impl World {
     /// on the soft step for the next second (`mark_soft_islands`): no island costs more
     /// than the budget for longer than a step.
     fn keep_over_budget_on_soft(&mut self, dt: f64) {
-        let over = &self.scratch.simultaneous.over_budget_bodies;
+        let over = &self.solvers.exact.over_budget_bodies;
         if over.is_empty() {
             return;
         }
         // This step's count is `step_count` until it ends: the next second of steps.
         let until = self.step_count + 1 + (SOFT_AFTER_OVER_BUDGET / dt).ceil() as u64;
-        self.soft_until.resize(self.bodies.len(), 0);
+        self.auto.soft_until.resize(self.bodies.len(), 0);
         // The static world's slot comes after the bodies'.
         for &i in over.iter().filter(|&&i| (i as usize) < self.bodies.len()) {
-            self.soft_until[i as usize] = until;
+            self.auto.soft_until[i as usize] = until;
         }
     }
 
@@ -318,10 +329,10 @@ mod tests {
         assert_eq!(unheld, overlapping_pairs(&world));
         let mut moving_in_pass = vec![];
         for soft in [true, false] {
-            let fat_boxes = world.scratch.fat_boxes.clone();
+            let fat_boxes = world.kept_pairs.bounds.clone();
             world.hold_where(soft);
             world.find_candidate_pairs(dt);
-            assert_eq!(world.scratch.fat_boxes, fat_boxes, "pairs kept");
+            assert_eq!(world.kept_pairs.bounds, fat_boxes, "pairs kept");
             assert_eq!(world.scratch.pairs, overlapping_pairs(&world));
             assert!(world.scratch.pairs.len() < unheld.len());
             moving_in_pass.push(world.scratch.pairs.len());
@@ -363,7 +374,7 @@ mod tests {
             }
             let kept = world.mark_soft_islands(dt);
             let kept_marks = world.scratch.in_soft_island.clone();
-            world.scratch.last_marking.found = None;
+            world.auto.last_marking.found = None;
             let fresh = world.mark_soft_islands(dt);
             assert_eq!(kept, fresh, "step {step}");
             assert_eq!(kept_marks, world.scratch.in_soft_island, "step {step}");

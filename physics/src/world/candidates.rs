@@ -113,14 +113,37 @@ fn keep_nearest_neighbours(
 
 /// How far two bodies can close on each other in a step, from each one's `motion`: their
 /// centroids' relative displacement and how far each one's spin carries its farthest point.
+/// The broad phase's pairs, kept from step to step while they still hold: found from the
+/// bounds grown by `broad_phase_margin` (or bare, while grown ones do not hold), and which
+/// bodies were static or asleep then (see `find_candidate_pairs`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct KeptPairs {
+    pub(super) bounds: Vec<Option<Aabb>>,
+    pairs: Vec<(u32, u32)>,
+    pub(super) fixed: Vec<bool>,
+    /// How many times in a row the broad phase has paired the bodies again (0: it kept its
+    /// pairs the last time).
+    paired_in_a_row: u32,
+    /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
+    /// the pairs.
+    crowded: bool,
+}
+
+impl KeptPairs {
+    /// Found again at the next step: the joints or ignored pairs changed.
+    fn forget(&mut self) {
+        self.bounds.clear();
+        self.fixed.clear();
+        self.pairs.clear();
+    }
+}
+
 impl World {
     pub(super) fn refresh_collision_filter(&mut self) {
         if !std::mem::take(&mut self.collision_filter_stale) {
             return;
         }
-        self.scratch.fat_boxes.clear();
-        self.scratch.fat_fixed.clear();
-        self.scratch.fat_pairs.clear();
+        self.kept_pairs.forget();
         self.jointed.clear();
         self.jointed.extend(
             self.joints
@@ -149,6 +172,7 @@ impl World {
     /// move in `dt`, overlap (pairs of fixed bodies and pairs kept apart left out).
     pub(super) fn find_candidate_pairs(&mut self, dt: f64) {
         let s = &mut self.scratch;
+        let kept = &mut self.kept_pairs;
         s.polygons
             .resize_with(self.bodies.len(), WorldPolygon::default);
         s.boxes.clear();
@@ -161,8 +185,8 @@ impl World {
         // The grown bounds' pairs still hold every pair whose bounds overlap now if every
         // body's bounds lie inside its grown ones, and the same bodies are fixed: checked
         // as the bounds are made, in the one pass over the bodies.
-        let mut still_inside = s.fat_boxes.len() == self.bodies.len();
-        let mut same_fixed = s.fat_fixed.len() == self.bodies.len();
+        let mut still_inside = kept.bounds.len() == self.bodies.len();
+        let mut same_fixed = kept.fixed.len() == self.bodies.len();
         let bodies = self.bodies.iter().zip(s.polygons.iter_mut()).enumerate();
         for (i, (body, polygon)) in bodies {
             // The speed of its farthest point from the spin alone.
@@ -181,13 +205,13 @@ impl World {
                 polygon.aabb().grown(0.5 * margin + reach)
             });
             if still_inside {
-                still_inside = match (&bounds, &s.fat_boxes[i]) {
+                still_inside = match (&bounds, &kept.bounds[i]) {
                     (Some(now), Some(fat)) => fat.contains(now),
                     (None, None) => true,
                     _ => false,
                 };
             }
-            same_fixed = same_fixed && s.fat_fixed[i] == is_fixed(body);
+            same_fixed = same_fixed && kept.fixed[i] == is_fixed(body);
             s.boxes.push(bounds);
         }
         let bodies = &self.bodies;
@@ -196,31 +220,31 @@ impl World {
         // of `auto` (whose two passes hold different bodies); those are dropped from its
         // pairs below, so that its pairs serve both passes.
         if still_inside && same_fixed {
-            s.paired_in_a_row = 0;
+            kept.paired_in_a_row = 0;
         } else {
-            s.paired_in_a_row = s.paired_in_a_row.wrapping_add(1);
+            kept.paired_in_a_row = kept.paired_in_a_row.wrapping_add(1);
             // Grown bounds pay while their pairs hold for a few steps. Where every step pairs
             // again anyway (the smash's flying debris) they only add pairs to compare and
             // sort: pair the bounds as they are, and try grown ones again now and then in
             // case the scene has settled. The candidates are the same either way.
             let grow_pays =
-                s.paired_in_a_row < 2 || s.paired_in_a_row.is_multiple_of(RETRY_GROWN_BOUNDS);
+                kept.paired_in_a_row < 2 || kept.paired_in_a_row.is_multiple_of(RETRY_GROWN_BOUNDS);
             let grow = if grow_pays {
                 self.settings.broad_phase_margin()
             } else {
                 0.0
             };
-            s.fat_boxes.clear();
-            s.fat_boxes
+            kept.bounds.clear();
+            kept.bounds
                 .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
-            s.fat_fixed.clear();
-            s.fat_fixed.extend(bodies.iter().map(is_fixed));
-            let (non_colliding, fixed) = (&self.non_colliding, &s.fat_fixed);
+            kept.fixed.clear();
+            kept.fixed.extend(bodies.iter().map(is_fixed));
+            let (non_colliding, fixed) = (&self.non_colliding, &kept.fixed);
             let wanted = |i: usize, j: usize| {
                 let both_fixed = fixed[i] & fixed[j];
                 !both_fixed && !non_colliding.contains((i as u32, j as u32))
             };
-            s.broad_phase.pairs(&s.fat_boxes, wanted, &mut s.fat_pairs);
+            s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
             s.radii.clear();
             s.radii.extend(
                 bodies
@@ -228,7 +252,7 @@ impl World {
                     .map(|b| b.as_ref().map_or(0.0, Body::bounding_radius)),
             );
             let room_taken = &mut s.neighbours.room_taken;
-            s.crowded = crowded(&s.fat_pairs, fixed, &s.radii, room_taken);
+            kept.crowded = crowded(&kept.pairs, fixed, &s.radii, room_taken);
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
         let boxes = &s.boxes;
@@ -238,7 +262,7 @@ impl World {
         };
         s.pairs.clear();
         if s.held.is_empty() {
-            s.pairs.extend(s.fat_pairs.iter().copied().filter(overlap));
+            s.pairs.extend(kept.pairs.iter().copied().filter(overlap));
         } else {
             s.fixed_now.clear();
             s.fixed_now
@@ -246,18 +270,18 @@ impl World {
             let fixed_now = &s.fixed_now;
             let one_moves = |&(i, j): &(u32, u32)| !(fixed_now[i as usize] & fixed_now[j as usize]);
             s.pairs.extend(
-                s.fat_pairs
+                kept.pairs
                     .iter()
                     .copied()
                     .filter(|p| one_moves(p) && overlap(p)),
             );
         }
-        if s.crowded {
+        if kept.crowded {
             s.grown_by.clear();
             s.grown_by
                 .extend(s.reach.iter().map(|reach| 0.5 * margin + reach));
             let sizes = (&s.boxes[..], &s.grown_by[..], &s.radii[..]);
-            keep_nearest_neighbours(&mut s.pairs, &s.fat_fixed, sizes, &mut s.neighbours);
+            keep_nearest_neighbours(&mut s.pairs, &kept.fixed, sizes, &mut s.neighbours);
         }
     }
 }
@@ -300,9 +324,9 @@ mod tests {
         let (mut kept, mut found) = (0, 0);
         for _ in 0..300 {
             world.step(dt);
-            let before = world.scratch.fat_boxes.clone();
+            let before = world.kept_pairs.bounds.clone();
             world.find_candidate_pairs(dt);
-            if world.scratch.fat_boxes == before {
+            if world.kept_pairs.bounds == before {
                 kept += 1;
             } else {
                 found += 1;
@@ -345,12 +369,12 @@ mod tests {
                 }
             }
             // The step's own broad phase, at the poses the step began with.
-            let before = world.scratch.fat_boxes.clone();
+            let before = world.kept_pairs.bounds.clone();
             world.step(dt);
             let s = &world.scratch;
-            if s.fat_boxes == before {
+            if world.kept_pairs.bounds == before {
                 kept += 1;
-            } else if s.fat_boxes == s.boxes {
+            } else if world.kept_pairs.bounds == s.boxes {
                 bare += 1;
             } else {
                 grown += 1;

@@ -137,7 +137,7 @@ impl World {
         let it = self.settings.joint_iterations(dt);
         let s = &mut self.scratch;
         pass(
-            &mut s.joint_solver,
+            &mut self.solvers.joints,
             &mut s.joint_constraints,
             &mut s.solver_bodies,
             &it,
@@ -185,7 +185,7 @@ impl World {
         };
         match method {
             ImpulseMethod::Sequential => {
-                s.simultaneous.reports.clear();
+                self.solvers.exact.reports.clear();
                 solve_sequential(
                     &mut self.contacts,
                     &mut s.solver_bodies,
@@ -199,9 +199,9 @@ impl World {
                 } else {
                     FrictionModel::Coupled
                 };
-                s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
-                s.simultaneous.propagate_impacts = self.settings.propagate_impacts;
-                s.simultaneous.solve(
+                self.solvers.exact.dense_row_limit = self.settings.dense_row_limit;
+                self.solvers.exact.propagate_impacts = self.settings.propagate_impacts;
+                self.solvers.exact.solve(
                     model,
                     &mut self.contacts,
                     &mut s.joint_constraints,
@@ -212,7 +212,7 @@ impl World {
         }
         if !s.joint_constraints.is_empty() {
             let it = self.settings.joint_iterations(dt);
-            s.joint_solver.correct_positions(
+            self.solvers.joints.correct_positions(
                 &mut s.joint_constraints,
                 &mut s.solver_bodies,
                 dt,
@@ -221,8 +221,8 @@ impl World {
             );
         }
         if !method.pushes_apart() {
-            s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
-            s.simultaneous.separate(
+            self.solvers.exact.dense_row_limit = self.settings.dense_row_limit;
+            self.solvers.exact.separate(
                 &self.contacts,
                 &s.joint_constraints,
                 &mut s.solver_bodies,

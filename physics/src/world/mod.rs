@@ -15,8 +15,8 @@ pub(crate) mod stats;
 
 use settings::{Integrator, StepSettings};
 
-use auto::{IslandNeeds, LastMarking};
-use candidates::NeighbourScratch;
+use auto::{AutoMemory, IslandNeeds};
+use candidates::{KeptPairs, NeighbourScratch};
 use solver_bodies::GapTargets;
 use stats::StepStats;
 
@@ -187,13 +187,17 @@ pub struct World {
     contacts: Vec<Contact>,
     /// Per body: the island it fell asleep with (woken together).
     sleep_labels: Vec<u32>,
-    /// Per body: under `auto`, the step until which its island stays on the soft step
-    /// (`keep_over_budget_on_soft`).
-    soft_until: Vec<u64>,
+    /// What `auto` keeps from step to step.
+    auto: AutoMemory,
     /// The world's own counts of `StepStats` (the soft step keeps its own).
     stats: StepStats,
     /// The ticks each stage of the last step took (`World::profile`).
     profile: StepProfile,
+    /// The broad phase's pairs, kept while they hold.
+    kept_pairs: KeptPairs,
+    /// The solvers, with what they keep from step to step: warm starts, factors, plans and
+    /// the islands' reports.
+    solvers: Solvers,
     scratch: Scratch,
 }
 
@@ -204,6 +208,16 @@ pub struct World {
 enum Pipeline {
     Impulses = 0,
     Soft = 1,
+}
+
+/// The solvers a world steps with, each keeping its memory between steps.
+#[derive(Debug, Clone, Default)]
+struct Solvers {
+    /// The pins' passes of the impulse stage list (`sequential`, `thesis`, `exact`).
+    joints: JointBlockSolver,
+    /// The islands' LCPs of `thesis` and `exact`, and the impact pass of every solver.
+    exact: SimultaneousSolver,
+    soft: SoftStepSolver,
 }
 
 /// Buffers reused from step to step so that stepping does not allocate.
@@ -219,18 +233,8 @@ struct Scratch {
     boxes: Vec<Option<Aabb>>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
-    /// The broad phase's own pairs, by the bounds grown by `broad_phase_margin` (or bare,
-    /// while grown ones do not hold), and which bodies were static or asleep then (see
-    /// `find_candidate_pairs`; emptied when they no longer stand).
-    fat_boxes: Vec<Option<Aabb>>,
-    fat_pairs: Vec<(u32, u32)>,
-    fat_fixed: Vec<bool>,
-    /// How many times in a row the broad phase has paired the bodies again (0: it kept its
-    /// pairs the last time).
-    paired_in_a_row: u32,
-    /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among the
-    /// broad phase's pairs, each body's bounding radius, and scratch for finding out.
-    crowded: bool,
+    /// Each body's bounding radius, and scratch for keeping a crowded body's nearest
+    /// neighbours (`KeptPairs::crowded`).
     radii: Vec<f64>,
     grown_by: Vec<f64>,
     neighbours: NeighbourScratch,
@@ -251,9 +255,6 @@ struct Scratch {
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
     joint_constraints: Vec<JointConstraint>,
-    joint_solver: JointBlockSolver,
-    simultaneous: SimultaneousSolver,
-    soft: SoftStepSolver,
     accelerations: Vec<(Vec2, f64)>,
     /// Every body's centroid and angle when the step began, for continuous collision.
     step_start: Vec<(Vec2, f64)>,
@@ -269,19 +270,17 @@ struct Scratch {
     impact_union: UnionFind,
     island_impact: Vec<f64>,
     /// `auto`: the islands' links and row counts, which bodies are in big islands, the
-    /// bodies held in the current pass, the exact pass's contacts while the soft pass
-    /// runs, and both passes' island reports.
+    /// bodies held in the current pass, and the exact pass's contacts while the soft pass
+    /// runs.
     auto_links: Vec<(u32, u32, usize)>,
     island_rows: Vec<usize>,
     island_needs: Vec<IslandNeeds>,
-    /// Per body: whether it is kept on the soft step this step (`World::soft_until`).
+    /// Per body: whether it is kept on the soft step this step (`AutoMemory::soft_until`).
     prefer_soft: Vec<bool>,
     in_soft_island: Vec<bool>,
-    last_marking: LastMarking,
     held: Vec<(u32, (Vec2, f64))>,
     exact_contacts: Vec<Contact>,
     exact_manifolds: Vec<Manifold>,
-    auto_reports: Vec<IslandReport>,
     /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
     /// the next contact detection at the same step length: set by `auto` only.
     candidates_current: bool,
@@ -565,7 +564,7 @@ impl World {
         self.profile = StepProfile::default();
         let started = stage_clock::mark();
         self.advance(dt);
-        self.profile.take_from(&mut self.scratch.soft.profile);
+        self.profile.take_from(&mut self.solvers.soft.profile);
         self.profile.record(Stage::Step, started);
         self.check_state()
     }
@@ -705,7 +704,7 @@ impl World {
                 self.propagate_impacts_before_soft_step(dt, &unforeseen);
             }
             let s = &mut self.scratch;
-            s.soft.step(
+            self.solvers.soft.step(
                 &SoftSettings {
                     substeps: self.settings.soft_substeps.max(1),
                     alternating_sweeps: self.settings.soft_alternating_sweeps,
@@ -769,8 +768,8 @@ impl World {
                 c.normal_velocity = c.normal_velocity.min(2.0 * c.depth / dt);
             }
         }
-        s.simultaneous.dense_row_limit = self.settings.dense_row_limit;
-        s.simultaneous.propagate_all_impacts(
+        self.solvers.exact.dense_row_limit = self.settings.dense_row_limit;
+        self.solvers.exact.propagate_all_impacts(
             &mut self.contacts,
             &s.joint_constraints,
             &mut s.solver_bodies,
@@ -794,7 +793,7 @@ impl World {
 
     /// What the steps so far did, counted: see [`StepStats`].
     pub fn stats(&self) -> StepStats {
-        let soft = &self.scratch.soft;
+        let soft = &self.solvers.soft;
         let pins = StepStats {
             soft_pin_factorisations: soft.pin_factorisations(),
             ..StepStats::default()
@@ -807,9 +806,9 @@ impl World {
     /// `thesis` the last substep's islands; under `soft` the step's; under `auto` both passes'.
     pub fn island_reports(&self) -> &[IslandReport] {
         match self.settings.contact_solver.stage_list() {
-            StageList::Impulses(_) => &self.scratch.simultaneous.reports,
-            StageList::Soft => &self.scratch.soft.reports,
-            StageList::Auto => &self.scratch.auto_reports,
+            StageList::Impulses(_) => &self.solvers.exact.reports,
+            StageList::Soft => &self.solvers.soft.reports,
+            StageList::Auto => &self.auto.reports,
         }
     }
 }
@@ -848,7 +847,7 @@ mod tests {
                         .unwrap();
                 }
             }
-            world.scratch.soft.write_every_point = write_every_point;
+            world.solvers.soft.write_every_point = write_every_point;
             world
         };
         let (mut skipping, mut writing) = (pile(false), pile(true));
