@@ -137,7 +137,7 @@ fn auto_solves_the_robot_exactly_and_the_pile_by_the_soft_step() {
     let touching = |w: &World, b: BodyHandle| {
         w.contacts()
             .iter()
-            .filter(|c| c.body_a == b.0 || c.body_b == b.0)
+            .filter(|c| c.body_a == b || c.body_b == b)
             .count()
     };
     assert_eq!(touching(&mixed, robot_in_mixed[3]), 2);

@@ -1,6 +1,7 @@
 //! Contact points as the solvers see them, and the simplest solver: one contact at a time.
 
 use super::SolverBody;
+use crate::body::BodyHandle;
 use crate::collide::FeatureId;
 use crate::math::{Vec2, clamp, cross, perp};
 
@@ -122,14 +123,14 @@ type Entry = ((u32, u32, u32), f64, f64);
 
 /// What a contact is remembered by: its bodies and its feature.
 fn key(c: &Contact) -> (u32, u32, u32) {
-    (c.body_a, c.body_b, c.id.0)
+    (c.body_a.0, c.body_b.0, c.id.0)
 }
 
 /// One contact point between bodies `a` and `b`, with its material and its last impulses.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
-    pub body_a: u32,
-    pub body_b: u32,
+    pub body_a: BodyHandle,
+    pub body_b: BodyHandle,
     pub point: Vec2,
     /// Unit normal from B towards A (SPEC §2.4).
     pub normal: Vec2,
@@ -187,7 +188,7 @@ impl Contact {
 
     /// Velocity of A's point relative to B's, `v_AB` (SPEC eq. 2–3).
     pub(crate) fn relative_velocity(&self, bodies: &[SolverBody]) -> Vec2 {
-        let (a, b) = (&bodies[self.body_a as usize], &bodies[self.body_b as usize]);
+        let (a, b) = (&bodies[self.body_a.index()], &bodies[self.body_b.index()]);
         a.velocity_at(self.point) - b.velocity_at(self.point)
     }
 
@@ -204,7 +205,7 @@ impl Contact {
         for (body, s_out) in [(self.body_a, 1.0), (self.body_b, -1.0)] {
             for (other_body, s_in) in [(other.body_a, 1.0), (other.body_b, -1.0)] {
                 if body == other_body {
-                    let t = &bodies[body as usize];
+                    let t = &bodies[body.index()];
                     let r_out = self.point - t.position;
                     let r_in = other.point - t.position;
                     sum += s_out
@@ -225,8 +226,8 @@ impl Contact {
         tangent_impulse: f64,
     ) {
         let impulse = self.normal * normal_impulse + self.tangent() * tangent_impulse;
-        bodies[self.body_a as usize].apply_impulse(impulse, self.point);
-        bodies[self.body_b as usize].apply_impulse(-impulse, self.point);
+        bodies[self.body_a.index()].apply_impulse(impulse, self.point);
+        bodies[self.body_b.index()].apply_impulse(-impulse, self.point);
     }
 }
 
@@ -308,8 +309,8 @@ mod tests {
         keys.iter()
             .enumerate()
             .map(|(k, &(a, b, id))| Contact {
-                body_a: a,
-                body_b: b,
+                body_a: BodyHandle(a),
+                body_b: BodyHandle(b),
                 point: Vec2::zeros(),
                 normal: Vec2::new(0.0, 1.0),
                 depth: 0.0,

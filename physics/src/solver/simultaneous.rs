@@ -322,7 +322,7 @@ impl SimultaneousSolver {
             .island_contacts
             .iter()
             .flat_map(|(_, c)| [c.body_a, c.body_b].map(|b| (b, c.point)))
-            .map(|(b, point)| pseudo[b as usize].velocity_at(point).norm() * dt)
+            .map(|(b, point)| pseudo[b.index()].velocity_at(point).norm() * dt)
             .fold(0.0, f64::max);
         if moved <= allowed {
             return;
@@ -348,7 +348,7 @@ impl SimultaneousSolver {
         let dynamic = |slot: u32| bodies[slot as usize].moves();
         let ends = |i: usize| {
             if i < nc {
-                (contacts[i].body_a, contacts[i].body_b)
+                (contacts[i].body_a.0, contacts[i].body_b.0)
             } else {
                 (joints[i - nc].body_a, joints[i - nc].body_b)
             }
@@ -811,5 +811,5 @@ impl SimultaneousSolver {
 /// pass on through the bodies at rest in contact with them.
 fn passes_on(c: &Contact, bodies: &[SolverBody], targets: &VelocityTargets) -> bool {
     let moves = |i: u32| bodies[i as usize].moves();
-    c.bounces(targets.dt, targets.bounce_below) && moves(c.body_a) && moves(c.body_b)
+    c.bounces(targets.dt, targets.bounce_below) && moves(c.body_a.0) && moves(c.body_b.0)
 }

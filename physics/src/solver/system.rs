@@ -130,7 +130,7 @@ pub(crate) fn velocity_rows(
         let points = if shares_face { 2 } else { 1 };
         let first_normal = rows.len();
         for &(index, c) in &contacts[k..k + points] {
-            let ends = point_row(c.body_a, c.body_b, c.point, c.point, c.normal, bodies);
+            let ends = point_row(c.body_a.0, c.body_b.0, c.point, c.point, c.normal, bodies);
             let mut row = Row {
                 kind: RowKind::ContactNormal(index),
                 ends,
@@ -160,7 +160,7 @@ pub(crate) fn velocity_rows(
                 let bound = FrictionBound::single(first_normal, c.friction);
                 (RowKind::ContactTangent(index), c.point, bound)
             };
-            let ends = point_row(c.body_a, c.body_b, point, point, c.tangent(), bodies);
+            let ends = point_row(c.body_a.0, c.body_b.0, point, point, c.tangent(), bodies);
             let mut t_row = Row {
                 kind,
                 ends,
@@ -253,6 +253,7 @@ pub(crate) fn assemble(rows: &[Row], bodies: &[SolverBody], a: &mut Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::body::BodyHandle;
     use crate::collide::FeatureId;
 
     /// The assembled A must equal the measured velocity response to unit impulses — the
@@ -277,8 +278,8 @@ mod tests {
             SolverBody::default(),
         ];
         let contact = |a: u32, b: u32, p: Vec2, n: Vec2| Contact {
-            body_a: a,
-            body_b: b,
+            body_a: BodyHandle(a),
+            body_b: BodyHandle(b),
             point: p,
             normal: n.normalize(),
             depth: 0.01,

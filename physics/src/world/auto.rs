@@ -130,7 +130,7 @@ impl World {
                 .binary_search_by(|m| (m.body_a.0, m.body_b.0).cmp(&(a, b)))
                 .is_ok()
         };
-        self.contacts.retain(|c| !seen(c.body_a, c.body_b));
+        self.contacts.retain(|c| !seen(c.body_a.0, c.body_b.0));
         self.manifolds.retain(|m| !seen(m.body_a.0, m.body_b.0));
         self.contacts.splice(0..0, s.exact_contacts.drain(..));
         self.manifolds.splice(0..0, s.exact_manifolds.drain(..));
@@ -156,7 +156,7 @@ impl World {
         let s = &mut self.scratch;
         let mut links: Vec<(u32, u32, usize)> = std::mem::take(&mut s.auto_links);
         links.clear();
-        links.extend(self.contacts.iter().map(|c| (c.body_a, c.body_b, 2)));
+        links.extend(self.contacts.iter().map(|c| (c.body_a.0, c.body_b.0, 2)));
         let contact_links = links.len();
         for j in self.joints.iter().flatten() {
             let rows = 2 + usize::from(j.motor.is_some_and(|m| m.enabled));

@@ -114,8 +114,8 @@ impl World {
                     (a.velocity_at(p.position) - b.velocity_at(p.position)).dot(&m.normal)
                 };
                 self.contacts.push(Contact {
-                    body_a: m.body_a.0,
-                    body_b: m.body_b.0,
+                    body_a: m.body_a,
+                    body_b: m.body_b,
                     point: p.position,
                     normal: m.normal,
                     depth: p.depth,

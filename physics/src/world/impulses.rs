@@ -94,16 +94,16 @@ impl World {
                 continue;
             }
             let is_fixed = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_fixed);
-            let (moving, direction) = match (is_fixed(c.body_a), is_fixed(c.body_b)) {
+            let (moving, direction) = match (is_fixed(c.body_a.0), is_fixed(c.body_b.0)) {
                 (false, true) => (c.body_a, -c.normal),
                 (true, false) => (c.body_b, c.normal),
                 _ => continue,
             };
             // Moving one part of a jointed mechanism would open its joints.
-            if self.jointed.binary_search(&moving).is_ok() {
+            if self.jointed.binary_search(&moving.0).is_ok() {
                 continue;
             }
-            if let Some(body) = self.bodies[moving as usize].as_mut() {
+            if let Some(body) = self.bodies[moving.index()].as_mut() {
                 body.position += direction * gap;
             }
         }

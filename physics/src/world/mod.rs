@@ -696,7 +696,7 @@ impl World {
             && self
                 .contacts
                 .iter()
-                .any(|c| c.restitution > 0.0 && moves(c.body_a) && moves(c.body_b));
+                .any(|c| c.restitution > 0.0 && moves(c.body_a.0) && moves(c.body_b.0));
         let found = may_bounce.then(|| self.contacts.clone());
         let mut unforeseen = Vec::new();
         loop {
@@ -743,10 +743,10 @@ impl World {
                 c.restitution > 0.0
                     && c.approach_velocity <= -bounce_below
                     && c.normal_impulse > 0.0
-                    && moves(c.body_a)
-                    && moves(c.body_b)
+                    && moves(c.body_a.0)
+                    && moves(c.body_b.0)
             })
-            .map(|c| (c.body_a, c.body_b))
+            .map(|c| (c.body_a.0, c.body_b.0))
             .collect();
         pairs.dedup();
         pairs
@@ -760,10 +760,10 @@ impl World {
         // The soft step's contacts carry the velocities of the step's start; whether
         // a pair meets this step also takes the step's forces (as `exact`'s do).
         for c in self.contacts.iter_mut() {
-            let (a, b) = (c.body_a as usize, c.body_b as usize);
+            let (a, b) = (c.body_a.index(), c.body_b.index());
             let kick = (s.accelerations[a].0 - s.accelerations[b].0).dot(&c.normal) * dt;
             c.normal_velocity = c.approach_velocity + kick;
-            if c.depth < 0.0 && unforeseen.contains(&(c.body_a, c.body_b)) {
+            if c.depth < 0.0 && unforeseen.contains(&(c.body_a.0, c.body_b.0)) {
                 // Closing twice the gap within the step: the pair meets.
                 c.normal_velocity = c.normal_velocity.min(2.0 * c.depth / dt);
             }

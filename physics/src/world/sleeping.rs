@@ -127,8 +127,8 @@ impl World {
         let uf = &mut self.scratch.island_union;
         uf.reset(n);
         for c in &self.contacts {
-            if moving(&self.bodies, c.body_a) && moving(&self.bodies, c.body_b) {
-                uf.union(c.body_a, c.body_b);
+            if moving(&self.bodies, c.body_a.0) && moving(&self.bodies, c.body_b.0) {
+                uf.union(c.body_a.0, c.body_b.0);
             }
         }
         for j in self.joints.iter().flatten() {

@@ -299,7 +299,7 @@ impl PointLevers {
     /// The levers of contact `c` about its bodies' centroids at the step's start.
     #[inline(always)]
     fn of(bodies: &[SolverBody], c: &Contact) -> Self {
-        let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+        let (a, b) = (&bodies[c.body_a.index()], &bodies[c.body_b.index()]);
         let n = c.normal;
         let (r_a, r_b) = (c.point - a.position, c.point - b.position);
         // r × n and r · n, each product added with one rounding (see `BodyPair`).
@@ -568,6 +568,7 @@ impl SoftStepSolver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::body::BodyHandle;
     use crate::collide::FeatureId;
 
     /// Boxes in columns on a fixed floor (the last body), and each box's two points on
@@ -588,8 +589,8 @@ mod tests {
                 let y = -(row as f64);
                 for (dx, id) in [(-0.5, 1), (0.5, 2)] {
                     contacts.push(Contact {
-                        body_a: bodies.len() as u32,
-                        body_b: below,
+                        body_a: BodyHandle(bodies.len() as u32),
+                        body_b: BodyHandle(below),
                         point: Vec2::new(x + dx, y),
                         normal: Vec2::new(0.0, -1.0),
                         depth: 0.004,
@@ -807,18 +808,18 @@ mod tests {
         // Box 35 on box 20 instead of box 34: the two columns' islands change.
         let mut moved = standing.clone();
         for c in &mut moved[70..72] {
-            c.body_b = 20;
+            c.body_b = BodyHandle(20);
         }
         // The box alone on box 39 instead of the floor: the last island (in the grouping
         // taken unchecked) joins another.
         let mut last_moved = standing.clone();
         for c in &mut last_moved[80..82] {
-            c.body_b = 39;
+            c.body_b = BodyHandle(39);
         }
         // Only a manifold's second point on another body (box 8 instead of box 9), in
         // the same island.
         let mut second_moved = standing.clone();
-        second_moved[21].body_b = 8;
+        second_moved[21].body_b = BodyHandle(8);
         // The first steps' contacts and the last step's, whether the last step's grouping
         // is the first steps' kept unchecked, and whether it is another.
         let cases = [

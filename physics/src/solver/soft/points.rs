@@ -71,9 +71,9 @@ impl SoftStepSolver {
             }
             let moves = |i: u32| self.bodies[i as usize].moves();
             let mut input = PlanInput::new(
-                (c.body_a, c.body_b),
+                (c.body_a.0, c.body_b.0),
                 k,
-                (moves(c.body_a), moves(c.body_b)),
+                (moves(c.body_a.0), moves(c.body_b.0)),
                 c.normal,
             );
             let second = second_point_of(contacts, grouped, k);
@@ -82,8 +82,8 @@ impl SoftStepSolver {
             }
             let coupled = second.is_some_and(|j| {
                 let pair = (
-                    &self.bodies[c.body_a as usize],
-                    &self.bodies[c.body_b as usize],
+                    &self.bodies[c.body_a.index()],
+                    &self.bodies[c.body_b.index()],
                 );
                 let (p, q) = (
                     PointLevers::of(bodies, c),
@@ -101,7 +101,7 @@ impl SoftStepSolver {
         }
         let ends = |k: usize| {
             let c = &contacts[grouped[k].1 as usize];
-            (c.body_a, c.body_b)
+            (c.body_a.0, c.body_b.0)
         };
         self.contact_lcp
             .classify(&self.bodies, &self.contact_islands, ends);
@@ -119,7 +119,7 @@ impl SoftStepSolver {
         let grouped = grouping.group(
             contacts.len(),
             self.bodies.len() - 1, // not the null body
-            |i| (contacts[i].body_a, contacts[i].body_b),
+            |i| (contacts[i].body_a.0, contacts[i].body_b.0),
             |i| self.bodies[i as usize].moves(),
         );
         island_ranges(grouped, &mut self.contact_islands);
@@ -191,16 +191,16 @@ impl SoftStepSolver {
                 .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut reading));
             let block = second.as_ref().and_then(|q| {
                 let pair = (
-                    &self.bodies[c.body_a as usize],
-                    &self.bodies[c.body_b as usize],
+                    &self.bodies[c.body_a.index()],
+                    &self.bodies[c.body_b.index()],
                 );
                 NormalBlock::of(pair, (&first, q))
             });
             let moves = |i: u32| self.bodies[i as usize].moves();
             let mut input = PlanInput::new(
-                (c.body_a, c.body_b),
+                (c.body_a.0, c.body_b.0),
                 k,
-                (moves(c.body_a), moves(c.body_b)),
+                (moves(c.body_a.0), moves(c.body_b.0)),
                 c.normal,
             );
             if let (Some(block), Some(q)) = (block, second) {
@@ -237,10 +237,10 @@ impl SoftStepSolver {
         let c = &contacts[i as usize];
         if let Some(ends) = reading.unchecked_ends {
             // Noted, not branched on: the building stops at the island's end.
-            reading.regrouped |= ends[i as usize] != (c.body_a, c.body_b);
+            reading.regrouped |= ends[i as usize] != (c.body_a.0, c.body_b.0);
         }
         let recall = &mut reading.recall;
-        let (a, b) = (&bodies[c.body_a as usize], &bodies[c.body_b as usize]);
+        let (a, b) = (&bodies[c.body_a.index()], &bodies[c.body_b.index()]);
         let levers = PointLevers::of(bodies, c);
         // A row's effective mass, 1 / (m_a⁻¹ + m_b⁻¹ + I_a⁻¹ l_a² + I_b⁻¹ l_b²).
         let mass = |levers: (f64, f64)| {
@@ -268,13 +268,12 @@ impl SoftStepSolver {
         let closing_acceleration = if c.restitution == 0.0 {
             0.0
         } else {
-            -(accelerations[c.body_a as usize].0 - accelerations[c.body_b as usize].0)
-                .dot(&c.normal)
+            -(accelerations[c.body_a.index()].0 - accelerations[c.body_b.index()].0).dot(&c.normal)
         };
         PointConstraint {
             contact: i,
-            a: c.body_a,
-            b: c.body_b,
+            a: c.body_a.0,
+            b: c.body_b.0,
             normal: c.normal,
             levers,
             base_separation: -c.depth,
