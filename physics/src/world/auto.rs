@@ -172,8 +172,9 @@ impl World {
         s.prefer_soft
             .extend((0..n).map(|i| soft_until.get(i).is_some_and(|&until| until > step)));
         // The marking is a function of its links, candidates, fixed bodies, limit and the
-        // bodies kept on the soft step alone (the fixed ones are `fat_fixed`: no body is
-        // held between passes): the same inputs, the same marks, without the union-find.
+        // bodies kept on the soft step alone (the fixed ones are `KeptPairs::fixed`: no
+        // body is held between passes): the same inputs, the same marks, without the
+        // union-find.
         let limit = self.settings.dense_row_limit;
         let last = &self.auto.last_marking;
         if let Some(marked) = last.found
@@ -329,10 +330,10 @@ mod tests {
         assert_eq!(unheld, overlapping_pairs(&world));
         let mut moving_in_pass = vec![];
         for soft in [true, false] {
-            let fat_boxes = world.kept_pairs.bounds.clone();
+            let kept_bounds = world.kept_pairs.bounds.clone();
             world.hold_where(soft);
             world.find_candidate_pairs(dt);
-            assert_eq!(world.kept_pairs.bounds, fat_boxes, "pairs kept");
+            assert_eq!(world.kept_pairs.bounds, kept_bounds, "pairs kept");
             assert_eq!(world.scratch.pairs, overlapping_pairs(&world));
             assert!(world.scratch.pairs.len() < unheld.len());
             moving_in_pass.push(world.scratch.pairs.len());
