@@ -1,11 +1,10 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
 use super::SolverBody;
-use super::envelope::EnvelopeLu;
 use super::island::{UnionFind, group_by_island};
+use super::pin_island::{Observed, PinIsland, displace_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
-use nalgebra::{DMatrix, DVector};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
 /// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (SPEC §3.3).
@@ -305,6 +304,13 @@ fn drive_motors_continue(
 /// Buffers for solving joints island by island, reused across steps.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct JointBlockSolver {
+    islands: JointIslands,
+    pin_island: PinIsland,
+}
+
+/// The joints grouped into islands, one island's copied out at a time.
+#[derive(Debug, Clone, Default)]
+struct JointIslands {
     uf: UnionFind,
     grouped: Vec<(u32, u32)>,
     island: Vec<JointConstraint>,
@@ -316,7 +322,7 @@ pub(crate) struct JointBlockSolver {
 /// on, turned by ω·ahead (`p_arms_ahead`): for the position pass that is the exact
 /// derivative of the predicted gap, so the Newton steps converge quadratically even for
 /// fast-spinning links.
-fn coupling_block(
+pub(super) fn coupling_block(
     (p, p_arms_ahead): (&JointConstraint, (Vec2, Vec2)),
     (q, q_arms): (&JointConstraint, (Vec2, Vec2)),
     bodies: &[SolverBody],
@@ -347,217 +353,6 @@ fn own_block(j: &JointConstraint, bodies: &[SolverBody], ahead: f64) -> [[f64; 2
     let arms_ahead = j.arms((angle_ahead(j.body_a), angle_ahead(j.body_b)));
     let arms_now = j.arms((angle(j.body_a), angle(j.body_b)));
     coupling_block((j, arms_ahead), (j, arms_now), bodies)
-}
-
-/// For each joint, the joints that share a moving body with it (itself among them), in
-/// increasing order: the only blocks of K that are not zero. A chain's K is block
-/// tridiagonal; filling all m² blocks cost a 40-link chain 6 ms a step.
-fn coupled_joints(joints: &[JointConstraint], bodies: &[SolverBody]) -> Vec<Vec<usize>> {
-    let moves = |i: u32| {
-        let b = &bodies[i as usize];
-        b.inv_mass != 0.0 || b.inv_inertia != 0.0
-    };
-    let mut on_body: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
-    for (q, j) in joints.iter().enumerate() {
-        for body in [j.body_a, j.body_b] {
-            if moves(body) {
-                on_body.entry(body).or_default().push(q);
-            }
-        }
-    }
-    joints
-        .iter()
-        .map(|j| {
-            let mut coupled: Vec<usize> = [j.body_a, j.body_b]
-                .iter()
-                .filter_map(|body| on_body.get(body))
-                .flatten()
-                .copied()
-                .collect();
-            coupled.sort_unstable();
-            coupled.dedup();
-            coupled
-        })
-        .collect()
-}
-
-/// What stays the same while an island's impulses are found and applied: each joint's
-/// arms at the bodies' present angles (impulses change velocities, not angles) and the
-/// joints each joint shares a moving body with.
-struct IslandLayout {
-    arms_now: Vec<(Vec2, Vec2)>,
-    coupled: Vec<Vec<usize>>,
-}
-
-impl IslandLayout {
-    fn new(joints: &[JointConstraint], bodies: &[SolverBody]) -> Self {
-        let angle = |i: u32| bodies[i as usize].angle;
-        Self {
-            arms_now: joints
-                .iter()
-                .map(|j| j.arms((angle(j.body_a), angle(j.body_b))))
-                .collect(),
-            coupled: coupled_joints(joints, bodies),
-        }
-    }
-}
-
-/// The impulses that make `residual` zero for all joints of an island at once, to first
-/// order: K ψ = −residual, with each joint's gap observed at `observed_arms` (the arms
-/// turned to where the gap is measured). `None` if K is singular beyond repair.
-fn island_impulses(
-    joints: &[JointConstraint],
-    bodies: &[SolverBody],
-    layout: &IslandLayout,
-    observed_arms: &[(Vec2, Vec2)],
-    residual: impl Fn(usize) -> Vec2,
-) -> Option<DVector<f64>> {
-    let n = 2 * joints.len();
-    let mut k = vec![0.0; n * n];
-    let mut rhs = DVector::<f64>::zeros(n);
-    for (p, coupled) in layout.coupled.iter().enumerate() {
-        for &q in coupled {
-            let block = coupling_block(
-                (&joints[p], observed_arms[p]),
-                (&joints[q], layout.arms_now[q]),
-                bodies,
-            );
-            for (r, row) in block.iter().enumerate() {
-                for (c, value) in row.iter().enumerate() {
-                    k[(2 * p + r) * n + 2 * q + c] = *value;
-                }
-            }
-        }
-        let d = residual(p);
-        rhs[2 * p] = -d.x;
-        rhs[2 * p + 1] = -d.y;
-    }
-    // Redundant joints (closed loops at special poses) make K singular: a regularisation
-    // far below the entries' rounding keeps the solve going without changing answers.
-    let scale = (0..n).map(|i| k[i * n + i]).fold(0.0, f64::max);
-    for i in 0..n {
-        k[i * n + i] += 1e-12 * scale;
-    }
-    // Within K's envelope where its pivots stay well away from zero (a chain's K is block
-    // tridiagonal: 2.4 -> 1.2 ms a step for 41 pins), densely with pivoting otherwise.
-    let mut envelope = EnvelopeLu::default();
-    let psi = if envelope.factor(&k, n, 1e-10 * scale) {
-        envelope.solve(rhs.as_mut_slice());
-        rhs
-    } else {
-        DMatrix::from_row_slice(n, n, &k).lu().solve(&rhs)?
-    };
-    psi.iter().all(|v| v.is_finite()).then_some(psi)
-}
-
-/// Applies `fraction` of the island impulses `psi` at the joints' present anchors.
-fn apply_island_impulses(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    layout: &IslandLayout,
-    psi: &DVector<f64>,
-    fraction: f64,
-) {
-    for (p, j) in joints.iter().enumerate() {
-        let impulse = Vec2::new(psi[2 * p], psi[2 * p + 1]) * fraction;
-        let (ia, ib) = (j.body_a as usize, j.body_b as usize);
-        let (r_a, r_b) = layout.arms_now[p];
-        let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
-        bodies[ia].apply_impulse(impulse, pa);
-        bodies[ib].apply_impulse(-impulse, pb);
-    }
-}
-
-/// Each joint's predicted gap `dt` on (relative to its target) and its arms turned to
-/// where that gap is measured; returns the largest gap.
-fn predicted_gaps(
-    joints: &[JointConstraint],
-    bodies: &[SolverBody],
-    dt: f64,
-    arms_ahead: &mut Vec<(Vec2, Vec2)>,
-    gaps: &mut Vec<Vec2>,
-) -> f64 {
-    arms_ahead.clear();
-    gaps.clear();
-    let mut worst: f64 = 0.0;
-    for j in joints {
-        let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
-        let turned = |b: &SolverBody| Rot::new(b.angle + b.angular_velocity * dt);
-        let arms = j.arms_turned((turned(a), turned(b)));
-        let end_a = a.position + a.velocity * dt + arms.0;
-        let end_b = b.position + b.velocity * dt + arms.1;
-        let gap = end_a - end_b - j.gap_target;
-        worst = worst.max(gap.norm());
-        arms_ahead.push(arms);
-        gaps.push(gap);
-    }
-    worst
-}
-
-/// Newton steps on the island's predicted gaps. Each step must shrink the worst gap; if a
-/// full step does not (far from the solution the rotation makes the gap very nonlinear,
-/// and a full step can leap to a wildly spinning solution), half steps are tried, and the
-/// pass stops if none helps. False if the direct solve is impossible.
-fn close_island_gaps(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    dt: f64,
-    it: &JointIterations,
-) -> bool {
-    let layout = IslandLayout::new(joints, bodies);
-    let (mut arms_ahead, mut gaps) = (Vec::new(), Vec::new());
-    let mut worst = predicted_gaps(joints, bodies, dt, &mut arms_ahead, &mut gaps);
-    let mut saved: Vec<(usize, SolverBody)> = Vec::new();
-    for _ in 0..it.max_sweeps.min(10) {
-        if worst < it.position_tolerance {
-            break;
-        }
-        let residual = |p: usize| gaps[p] / dt;
-        let Some(psi) = island_impulses(joints, bodies, &layout, &arms_ahead, residual) else {
-            return false;
-        };
-        saved.clear();
-        saved.extend(island_bodies(joints).map(|i| (i, bodies[i])));
-        let mut fraction = 1.0;
-        let mut improved = false;
-        for _ in 0..5 {
-            apply_island_impulses(joints, bodies, &layout, &psi, fraction);
-            let now = predicted_gaps(joints, bodies, dt, &mut arms_ahead, &mut gaps);
-            if now < worst {
-                worst = now;
-                improved = true;
-                break;
-            }
-            for &(i, b) in &saved {
-                bodies[i] = b;
-            }
-            fraction *= 0.5;
-        }
-        if !improved {
-            break; // the rest waits for the next step (see the note on heavy chains)
-        }
-    }
-    true
-}
-
-/// Moves `fraction` of the displacement that the island impulses `psi` would cause in one
-/// second: Δx = M⁻¹ψ, Δθ = I⁻¹ r×ψ. Positions change, velocities do not.
-fn displace_island(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    psi: &DVector<f64>,
-    fraction: f64,
-) {
-    for (p, j) in joints.iter().enumerate() {
-        let push = Vec2::new(psi[2 * p], psi[2 * p + 1]) * fraction;
-        let (ia, ib) = (j.body_a as usize, j.body_b as usize);
-        let (r_a, r_b) = j.arms((bodies[ia].angle, bodies[ib].angle));
-        for (i, r, sign) in [(ia, r_a, 1.0), (ib, r_b, -1.0)] {
-            let b = &mut bodies[i];
-            b.position += push * (sign * b.inv_mass);
-            b.angle += sign * b.inv_inertia * crate::math::cross(r, push);
-        }
-    }
 }
 
 /// The repair moves bodies by the smallest mass-weighted displacement, with rotations
@@ -596,57 +391,6 @@ fn repair_residual(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
     j.predicted_gap(bodies, 0.0) - j.gap_target
 }
 
-/// Newton steps on the island's current gaps, moving bodies (not their velocities) until
-/// each joint is at its repair target. Backtracks like [`close_island_gaps`]. False if the
-/// direct solve is impossible.
-fn repair_island_positions(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    it: &JointIterations,
-) -> bool {
-    let joints = with_repair_targets(joints, bodies, it);
-    let worst_of = |bodies: &[SolverBody]| {
-        joints
-            .iter()
-            .map(|j| repair_residual(j, bodies).norm_squared())
-            .sum::<f64>()
-            .sqrt()
-    };
-    let mut worst = worst_of(bodies);
-    for _ in 0..20 {
-        if worst < it.position_tolerance {
-            break;
-        }
-        let layout = IslandLayout::new(&joints, bodies);
-        let residual = |p: usize| repair_residual(&joints[p], bodies);
-        let Some(psi) = island_impulses(&joints, bodies, &layout, &layout.arms_now, residual)
-        else {
-            return false;
-        };
-        let saved: Vec<(usize, SolverBody)> =
-            island_bodies(&joints).map(|i| (i, bodies[i])).collect();
-        let mut fraction = 1.0;
-        let mut improved = false;
-        for _ in 0..12 {
-            displace_island(&joints, bodies, &psi, fraction);
-            let now = worst_of(bodies);
-            if now < worst {
-                worst = now;
-                improved = true;
-                break;
-            }
-            for &(i, b) in &saved {
-                bodies[i] = b;
-            }
-            fraction *= 0.5;
-        }
-        if !improved {
-            break;
-        }
-    }
-    true
-}
-
 /// The same repair one joint at a time, by Gauss–Seidel sweeps (large islands).
 fn repair_positions_sequential(
     joints: &[JointConstraint],
@@ -662,12 +406,7 @@ fn repair_positions_sequential(
             let Some(push) = solve_2x2(own_block(j, bodies, 0.0), -d) else {
                 continue;
             };
-            displace_island(
-                std::slice::from_ref(j),
-                bodies,
-                &DVector::from_column_slice(&[push.x, push.y]),
-                1.0,
-            );
+            displace_island(std::slice::from_ref(j), bodies, &[push.x, push.y], 1.0);
         }
         if worst < it.position_tolerance {
             break;
@@ -688,9 +427,9 @@ fn anchor_velocity_gap(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
     a.velocity_at(a.position + r_a) - b.velocity_at(b.position + r_b)
 }
 
-impl JointBlockSolver {
+impl JointIslands {
     /// Calls `solve` once per island with that island's joints, copied contiguously.
-    fn for_each_island(
+    fn for_each(
         &mut self,
         joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
@@ -726,7 +465,9 @@ impl JointBlockSolver {
             start = end;
         }
     }
+}
 
+impl JointBlockSolver {
     /// Before a step: every broken joint (wider than [`JointIterations::broken_gap`]) is
     /// pulled up to `max_closing` closer by moving the bodies of its island, which adds no
     /// kinetic energy — a stretched chain snaps together instead of whipping. Does
@@ -743,7 +484,8 @@ impl JointBlockSolver {
         {
             return;
         }
-        self.for_each_island(joints, bodies, |island, bodies| {
+        let pin_island = &mut self.pin_island;
+        self.islands.for_each(joints, bodies, |island, bodies| {
             let mut slots: Vec<usize> = island_bodies(island).collect();
             slots.sort_unstable();
             slots.dedup();
@@ -751,7 +493,8 @@ impl JointBlockSolver {
                 bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
             }
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
-            if !(direct && repair_island_positions(island, bodies, it)) {
+            let targets = || with_repair_targets(island, bodies, it);
+            if !(direct && pin_island.repair(&targets(), bodies, it)) {
                 repair_positions_sequential(island, bodies, it);
             }
             for &i in &slots {
@@ -767,14 +510,17 @@ impl JointBlockSolver {
         bodies: &mut [SolverBody],
         it: &JointIterations,
     ) {
-        self.for_each_island(joints, bodies, |island, bodies| {
+        let pin_island = &mut self.pin_island;
+        self.islands.for_each(joints, bodies, |island, bodies| {
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
             let solved = direct && {
-                let layout = IslandLayout::new(island, bodies);
+                pin_island.lay_out(island, bodies);
                 let residual = |p: usize| anchor_velocity_gap(&island[p], bodies);
-                island_impulses(island, bodies, &layout, &layout.arms_now, residual)
-                    .map(|psi| apply_island_impulses(island, bodies, &layout, &psi, 1.0))
-                    .is_some()
+                let found = pin_island.find_impulses(island, bodies, Observed::Now, residual);
+                if found {
+                    pin_island.apply_impulses(island, bodies, 1.0);
+                }
+                found
             };
             if !solved {
                 correct_velocities(island, bodies, it);
@@ -793,7 +539,8 @@ impl JointBlockSolver {
         it: &JointIterations,
         motors_started: bool,
     ) {
-        self.for_each_island(joints, bodies, |island, bodies| {
+        let pin_island = &mut self.pin_island;
+        self.islands.for_each(joints, bodies, |island, bodies| {
             let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
             if !direct {
@@ -809,7 +556,7 @@ impl JointBlockSolver {
                     // Keep what the contact solve already pushed so the bound holds overall.
                     drive_motors_continue(island, bodies, dt, 4, round == 0 && !motors_started);
                 }
-                if !close_island_gaps(island, bodies, dt, it) {
+                if !pin_island.close_gaps(island, bodies, dt, it) {
                     correct_positions(island, bodies, dt, it);
                     break;
                 }

@@ -6,6 +6,7 @@ pub(crate) mod island;
 pub(crate) mod joint;
 pub(crate) mod lcp;
 pub(crate) mod motor;
+mod pin_island;
 pub(crate) mod simultaneous;
 pub(crate) mod soft;
 pub(crate) mod system;
