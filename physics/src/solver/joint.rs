@@ -2,7 +2,7 @@
 
 use super::SolverBody;
 use super::island::{UnionFind, group_by_island};
-use super::pin_island::{Observed, PinIsland, displace_island};
+use super::pin_island::{PinIsland, displace_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
 
@@ -421,12 +421,6 @@ fn island_bodies(joints: &[JointConstraint]) -> impl Iterator<Item = usize> + '_
         .flat_map(|j| [j.body_a as usize, j.body_b as usize])
 }
 
-fn anchor_velocity_gap(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
-    let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
-    let (r_a, r_b) = j.arms((a.angle, b.angle));
-    a.velocity_at(a.position + r_a) - b.velocity_at(b.position + r_b)
-}
-
 impl JointIslands {
     /// Calls `solve` once per island with that island's joints, copied contiguously.
     fn for_each(
@@ -513,15 +507,7 @@ impl JointBlockSolver {
         let pin_island = &mut self.pin_island;
         self.islands.for_each(joints, bodies, |island, bodies| {
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
-            let solved = direct && {
-                pin_island.lay_out(island, bodies);
-                let residual = |p: usize| anchor_velocity_gap(&island[p], bodies);
-                let found = pin_island.find_impulses(island, bodies, Observed::Now, residual);
-                if found {
-                    pin_island.apply_impulses(island, bodies, 1.0);
-                }
-                found
-            };
+            let solved = direct && pin_island.stop_drift(island, bodies);
             if !solved {
                 correct_velocities(island, bodies, it);
             }

@@ -11,7 +11,7 @@ use nalgebra::{DMatrix, DVector};
 /// Where the joints' gaps are observed when K is built: at the bodies' present angles, or
 /// turned on by ω·dt to where the predicted gaps look (`PinIsland::predicted_gaps`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Observed {
+enum Observed {
     Now,
     Ahead,
 }
@@ -53,7 +53,7 @@ pub(super) struct PinIsland {
 impl PinIsland {
     /// The island's bodies, the joints' places among them, the arms at the present angles
     /// and the coupled joints.
-    pub(super) fn lay_out(&mut self, joints: &[JointConstraint], bodies: &[SolverBody]) {
+    fn lay_out(&mut self, joints: &[JointConstraint], bodies: &[SolverBody]) {
         self.slots.clear();
         self.slots
             .extend(joints.iter().flat_map(|j| [j.body_a, j.body_b]));
@@ -112,7 +112,7 @@ impl PinIsland {
     /// The impulses that make `residual` zero for all joints of the island at once, to
     /// first order: K ψ = −residual, each joint's gap observed as `observed` says, into
     /// `self.psi`. False if K is singular beyond repair.
-    pub(super) fn find_impulses(
+    fn find_impulses(
         &mut self,
         joints: &[JointConstraint],
         bodies: &[SolverBody],
@@ -168,12 +168,7 @@ impl PinIsland {
     }
 
     /// Applies `fraction` of the impulses found at the joints' present anchors.
-    pub(super) fn apply_impulses(
-        &self,
-        joints: &[JointConstraint],
-        bodies: &mut [SolverBody],
-        fraction: f64,
-    ) {
+    fn apply_impulses(&self, joints: &[JointConstraint], bodies: &mut [SolverBody], fraction: f64) {
         for (p, j) in joints.iter().enumerate() {
             let impulse = Vec2::new(self.psi[2 * p], self.psi[2 * p + 1]) * fraction;
             let (ia, ib) = (j.body_a as usize, j.body_b as usize);
@@ -211,6 +206,28 @@ impl PinIsland {
             self.gaps.push(gap);
         }
         worst
+    }
+
+    /// Stage 1 (SPEC eq. 40) for the whole island at once: impulses that make every
+    /// joint's anchors move together. False if the direct solve is impossible.
+    pub(super) fn stop_drift(
+        &mut self,
+        joints: &[JointConstraint],
+        bodies: &mut [SolverBody],
+    ) -> bool {
+        self.lay_out(joints, bodies);
+        let mut drift = std::mem::take(&mut self.gaps);
+        drift.clear();
+        drift.extend(joints.iter().zip(&self.arms_now).map(|(j, &(r_a, r_b))| {
+            let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
+            a.velocity_at(a.position + r_a) - b.velocity_at(b.position + r_b)
+        }));
+        let found = self.find_impulses(joints, bodies, Observed::Now, |p| drift[p]);
+        self.gaps = drift;
+        if found {
+            self.apply_impulses(joints, bodies, 1.0);
+        }
+        found
     }
 
     /// Newton steps on the island's predicted gaps. Each step must shrink the worst gap; if
