@@ -114,20 +114,21 @@ pub(crate) struct EnvelopeLu {
 }
 
 impl EnvelopeLu {
-    /// Factors `k` (row-major n × n). False if a pivot's magnitude is not above
-    /// `min_pivot`.
-    pub(crate) fn factor(&mut self, k: &[f64], n: usize, min_pivot: f64) -> bool {
+    /// Factors `k` (row-major n × n) within the envelope `first`: `first[i]` is at or left
+    /// of the first nonzero of row i and of column i (a caller that knows K's pattern says
+    /// so, rather than having all n² entries scanned). False if a pivot's magnitude is not
+    /// above `min_pivot`.
+    pub(crate) fn factor(&mut self, k: &[f64], n: usize, first: &[usize], min_pivot: f64) -> bool {
         debug_assert_eq!(k.len(), n * n);
+        debug_assert_eq!(first.len(), n);
         self.n = n;
         self.first.clear();
-        self.first.extend((0..n).map(|i| {
-            (0..i)
-                .find(|&j| k[i * n + j] != 0.0 || k[j * n + i] != 0.0)
-                .unwrap_or(i)
-        }));
+        self.first.extend_from_slice(first);
         self.start.clear();
         let mut stored = 0;
         for (i, &first) in self.first.iter().enumerate() {
+            debug_assert!(first <= i);
+            debug_assert!((0..first).all(|j| k[i * n + j] == 0.0 && k[j * n + i] == 0.0));
             self.start.push(stored);
             stored += 2 * (i - first) + 1;
         }
@@ -192,6 +193,18 @@ impl EnvelopeLu {
 mod tests {
     use super::*;
     use nalgebra::{DMatrix, DVector};
+
+    /// Each row's first column where row or column i is nonzero: K's envelope, found by
+    /// scanning.
+    fn envelope_of(k: &[f64], n: usize) -> Vec<usize> {
+        (0..n)
+            .map(|i| {
+                (0..i)
+                    .find(|&j| k[i * n + j] != 0.0 || k[j * n + i] != 0.0)
+                    .unwrap_or(i)
+            })
+            .collect()
+    }
 
     fn lcg(seed: &mut u64) -> f64 {
         *seed = seed
@@ -282,7 +295,7 @@ mod tests {
             let k: Vec<f64> = (0..n * n).map(|x| a[(x / n, x % n)]).collect();
             let b = DVector::from_fn(n, |_, _| lcg(&mut seed));
             let mut envelope = EnvelopeLu::default();
-            assert!(envelope.factor(&k, n, 0.0));
+            assert!(envelope.factor(&k, n, &envelope_of(&k, n), 0.0));
             let mut x: Vec<f64> = b.iter().copied().collect();
             envelope.solve(&mut x);
             let expected = a.clone().lu().solve(&b).unwrap();
@@ -294,6 +307,6 @@ mod tests {
             }
         }
         let singular = [1.0, 2.0, 2.0, 4.0];
-        assert!(!EnvelopeLu::default().factor(&singular, 2, 1e-12));
+        assert!(!EnvelopeLu::default().factor(&singular, 2, &[0, 0], 1e-12));
     }
 }

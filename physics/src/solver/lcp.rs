@@ -119,9 +119,15 @@ pub(crate) struct LcpSolver {
     clamped: Vec<usize>,
     /// Cholesky factor of `A_CC` (row-major, `n` columns reserved per row).
     factor: Vec<f64>,
+    /// Each factor row's first column that may be nonzero. A clamped index couples to few
+    /// others (a chain's pins to their neighbours' only), and its factor row is zero left
+    /// of the first it couples to: the factor and its solves skip those zeros.
+    factor_first: Vec<usize>,
     dx: Vec<f64>,
     dw: Vec<f64>,
     rhs: Vec<f64>,
+    /// The indices not in `C`, increasing (`solve_with_last_sets`).
+    unclamped: Vec<usize>,
     previous: Vec<f64>,
     /// The round before `previous`'s solution (damped friction bounds).
     older: Vec<f64>,
@@ -332,11 +338,15 @@ impl LcpSolver {
         if !self.x.iter().all(|v| v.is_finite()) {
             return false;
         }
+        self.unclamped.clear();
+        self.unclamped
+            .extend((0..n).filter(|&j| self.set[j] != Set::Clamped));
         self.rhs.clear();
         for &i in &self.clamped {
-            let bounded: f64 = (0..n)
-                .filter(|&j| self.set[j] != Set::Clamped)
-                .map(|j| self.a[i * n + j] * self.x[j])
+            let bounded: f64 = self
+                .unclamped
+                .iter()
+                .map(|&j| self.a[i * n + j] * self.x[j])
                 .sum();
             self.rhs.push(-self.b[i] - bounded);
         }
@@ -380,6 +390,7 @@ impl LcpSolver {
         self.clamped.clear();
         self.factor.clear();
         self.factor.resize(n * n, 0.0);
+        self.factor_first.clear();
         // At a bound where the guess is within rounding of it: the guess is the last
         // step's final round, itself only as exact as its solve (see `STALLED_ROUNDS`).
         let size = self.x.iter().map(|v| v.abs()).fold(0.0, f64::max);
@@ -481,6 +492,7 @@ impl LcpSolver {
         self.clamped.clear();
         self.factor.clear();
         self.factor.resize(n * n, 0.0);
+        self.factor_first.clear();
         self.dx.resize(n, 0.0);
         self.dw.resize(n, 0.0);
         // The cap is per call: each friction round pivots afresh.
@@ -624,14 +636,19 @@ impl LcpSolver {
     fn join_clamped(&mut self, j: usize) -> bool {
         let n = self.b.len();
         let m = self.clamped.len();
-        for k in 0..m {
+        // Left of the first clamped index that row j couples to, the new row is zero.
+        let first = (0..m)
+            .find(|&k| self.a[self.clamped[k] * n + j] != 0.0)
+            .unwrap_or(m);
+        self.factor[m * n..m * n + first].fill(0.0);
+        for k in first..m {
             let mut sum = self.a[self.clamped[k] * n + j];
-            for c in 0..k {
+            for c in first.max(self.factor_first[k])..k {
                 sum -= self.factor[m * n + c] * self.factor[k * n + c];
             }
             self.factor[m * n + k] = sum / self.factor[k * n + k];
         }
-        let row_norm: f64 = (0..m).map(|c| self.factor[m * n + c].powi(2)).sum();
+        let row_norm: f64 = (first..m).map(|c| self.factor[m * n + c].powi(2)).sum();
         // Equality rows (unbounded both ways: pins) are not regularised in `A`, where
         // 1e-12 of compliance would loosen a heavy chain; their factor still is, as a
         // floor for a singular set of them.
@@ -639,6 +656,7 @@ impl LcpSolver {
         let floor = if equality { REGULARISATION } else { 0.0 };
         let pivot = self.a[j * n + j] + floor - row_norm;
         self.factor[m * n + m] = pivot.max(REGULARISATION).sqrt();
+        self.factor_first.push(first);
         self.clamped.push(j);
         self.set[j] = Set::Clamped;
         self.factor[m * n + m].is_finite()
@@ -684,6 +702,13 @@ impl LcpSolver {
                 }
             }
         }
+        // The rotations mix neighbouring columns: each row's zeros are found afresh.
+        self.factor_first.clear();
+        for row in 0..m {
+            let entries = &self.factor[row * n..row * n + row];
+            let first = entries.iter().position(|&v| v != 0.0).unwrap_or(row);
+            self.factor_first.push(first);
+        }
     }
 
     /// Solves `A_CC z = rhs` in place with the factor.
@@ -692,7 +717,7 @@ impl LcpSolver {
         let m = self.clamped.len();
         for r in 0..m {
             let mut sum = self.rhs[r];
-            for c in 0..r {
+            for c in self.factor_first[r]..r {
                 sum -= self.factor[r * n + c] * self.rhs[c];
             }
             self.rhs[r] = sum / self.factor[r * n + r];
@@ -700,7 +725,9 @@ impl LcpSolver {
         for r in (0..m).rev() {
             let mut sum = self.rhs[r];
             for c in r + 1..m {
-                sum -= self.factor[c * n + r] * self.rhs[c];
+                if self.factor_first[c] <= r {
+                    sum -= self.factor[c * n + r] * self.rhs[c];
+                }
             }
             self.rhs[r] = sum / self.factor[r * n + r];
         }

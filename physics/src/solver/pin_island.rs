@@ -45,6 +45,9 @@ pub(super) struct PinIsland {
     /// The bodies as they were before a trial step.
     saved: Vec<(usize, SolverBody)>,
     k: Vec<f64>,
+    /// Each row of K's first column that may be nonzero: joint p's rows start at its
+    /// first coupled joint's.
+    k_first: Vec<usize>,
     /// The right-hand side, and then the impulses ψ.
     psi: Vec<f64>,
     envelope: EnvelopeLu,
@@ -120,8 +123,11 @@ impl PinIsland {
         residual: impl Fn(usize) -> Vec2,
     ) -> bool {
         let n = 2 * joints.len();
-        self.k.clear();
-        self.k.resize(n * n, 0.0);
+        // K is kept zero between solves (`clear_k`): only its coupled blocks are written.
+        if self.k.len() != n * n {
+            self.k.clear();
+            self.k.resize(n * n, 0.0);
+        }
         self.psi.clear();
         self.psi.resize(n, 0.0);
         let observed_arms = match observed {
@@ -152,19 +158,46 @@ impl PinIsland {
         for i in 0..n {
             self.k[i * n + i] += 1e-12 * scale;
         }
+        self.k_first.clear();
+        for p in 0..joints.len() {
+            let coupled = &self.coupled[self.coupled_start[p]..self.coupled_start[p + 1]];
+            let first = 2 * coupled.first().map_or(p, |&q| q.min(p));
+            self.k_first.extend([first, first]);
+        }
         // Within K's envelope where its pivots stay well away from zero (a chain's K is
         // block tridiagonal: 2.4 -> 1.2 ms a step for 41 pins), densely with pivoting
         // otherwise.
-        if self.envelope.factor(&self.k, n, 1e-10 * scale) {
+        let solved = if self
+            .envelope
+            .factor(&self.k, n, &self.k_first, 1e-10 * scale)
+        {
             self.envelope.solve(&mut self.psi);
+            true
         } else {
             let rhs = DVector::from_column_slice(&self.psi);
-            let Some(psi) = DMatrix::from_row_slice(n, n, &self.k).lu().solve(&rhs) else {
-                return false;
-            };
-            self.psi.copy_from_slice(psi.as_slice());
+            let dense = DMatrix::from_row_slice(n, n, &self.k).lu().solve(&rhs);
+            dense.is_some_and(|psi| {
+                self.psi.copy_from_slice(psi.as_slice());
+                true
+            })
+        };
+        self.clear_k(joints.len());
+        solved && self.psi.iter().all(|v| v.is_finite())
+    }
+
+    /// Zeroes what `find_impulses` wrote into K: the coupled blocks and the diagonal.
+    fn clear_k(&mut self, joint_count: usize) {
+        let n = 2 * joint_count;
+        for p in 0..joint_count {
+            for &q in &self.coupled[self.coupled_start[p]..self.coupled_start[p + 1]] {
+                for r in 2 * p..2 * p + 2 {
+                    self.k[r * n + 2 * q..r * n + 2 * q + 2].fill(0.0);
+                }
+            }
         }
-        self.psi.iter().all(|v| v.is_finite())
+        for i in 0..n {
+            self.k[i * n + i] = 0.0;
+        }
     }
 
     /// Applies `fraction` of the impulses found at the joints' present anchors.
