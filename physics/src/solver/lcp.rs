@@ -445,8 +445,11 @@ impl LcpSolver {
             }
         }));
         self.a.clear();
-        self.a
-            .extend((0..n * n).map(|k| self.scale[k / n] * p.a[k] * self.scale[k % n]));
+        for (i, row) in p.a[..n * n].chunks_exact(n).enumerate() {
+            let scale_i = self.scale[i];
+            self.a
+                .extend(row.iter().zip(&self.scale).map(|(a, s)| scale_i * a * s));
+        }
         for i in 0..n {
             let bounded = p.lo[i].is_finite() || p.hi[i].is_finite();
             if bounded || p.friction_index.is_some_and(|f| f[i].is_some()) {

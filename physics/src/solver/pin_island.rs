@@ -21,6 +21,8 @@ enum Observed {
 /// Newton steps.
 #[derive(Debug, Clone, Default)]
 pub(super) struct PinIsland {
+    /// What the layout was made from: each joint's two bodies and whether each moves.
+    layout_key: Vec<(u32, u32, bool, bool)>,
     /// The island's body slots, sorted, and each joint's two by their place among them.
     slots: Vec<u32>,
     ends: Vec<(usize, usize)>,
@@ -55,8 +57,42 @@ pub(super) struct PinIsland {
 
 impl PinIsland {
     /// The island's bodies, the joints' places among them, the arms at the present angles
-    /// and the coupled joints.
+    /// and the coupled joints. The structure depends only on which bodies each joint holds
+    /// and which of them move: it is kept while those stay (an island is laid out several
+    /// times a substep), and only the arms are turned afresh.
     fn lay_out(&mut self, joints: &[JointConstraint], bodies: &[SolverBody]) {
+        let moves = |slot: u32| {
+            let b = &bodies[slot as usize];
+            b.inv_mass != 0.0 || b.inv_inertia != 0.0
+        };
+        let key = |j: &JointConstraint| (j.body_a, j.body_b, moves(j.body_a), moves(j.body_b));
+        let same = self.layout_key.len() == joints.len()
+            && self
+                .layout_key
+                .iter()
+                .zip(joints)
+                .all(|(k, j)| *k == key(j));
+        if !same {
+            self.layout_key.clear();
+            self.layout_key.extend(joints.iter().map(key));
+            self.lay_out_structure(joints, bodies);
+        }
+        self.turned_now.clear();
+        self.turned_now.extend(
+            self.slots
+                .iter()
+                .map(|&i| Rot::new(bodies[i as usize].angle)),
+        );
+        self.arms_now.clear();
+        for (j, &(a, b)) in joints.iter().zip(&self.ends) {
+            let arms = j.arms_turned((self.turned_now[a], self.turned_now[b]));
+            self.arms_now.push(arms);
+        }
+    }
+
+    /// `lay_out`'s structure: the bodies, the joints' ends among them and the coupled
+    /// joints.
+    fn lay_out_structure(&mut self, joints: &[JointConstraint], bodies: &[SolverBody]) {
         self.slots.clear();
         self.slots
             .extend(joints.iter().flat_map(|j| [j.body_a, j.body_b]));
@@ -69,17 +105,6 @@ impl PinIsland {
                 .iter()
                 .map(|j| (place(j.body_a, &self.slots), place(j.body_b, &self.slots))),
         );
-        self.turned_now.clear();
-        self.turned_now.extend(
-            self.slots
-                .iter()
-                .map(|&i| Rot::new(bodies[i as usize].angle)),
-        );
-        self.arms_now.clear();
-        for (j, &(a, b)) in joints.iter().zip(&self.ends) {
-            let arms = j.arms_turned((self.turned_now[a], self.turned_now[b]));
-            self.arms_now.push(arms);
-        }
         let moves = |slot: u32| {
             let b = &bodies[slot as usize];
             b.inv_mass != 0.0 || b.inv_inertia != 0.0
