@@ -134,28 +134,31 @@ impl EnvelopeLu {
         }
         self.lu.clear();
         self.lu.resize(stored, 0.0);
+        let (first, lu) = (&self.first, &mut self.lu);
+        // Row r of L at column m is `lu[l_base(r) + m]`, column c of U at row m is
+        // `lu[u_base(c) + m]`: the inner sums index by m alone.
+        let l_base = |r: usize| self.start[r] - first[r];
+        let u_base = |c: usize| self.start[c] + c - 2 * first[c];
         for i in 0..n {
-            let first_i = self.first[i];
-            let width = i - first_i;
+            let first_i = first[i];
+            let (l_i, u_i) = (l_base(i), u_base(i));
             // Column i of U above the diagonal, then row i of L, then U_ii.
             for j in first_i..i {
-                let from = first_i.max(self.first[j]);
-                let sum: f64 = (from..j).map(|m| self.l(j, m) * self.u(m, i)).sum();
-                let at = self.start[i] + width + (j - first_i);
-                self.lu[at] = k[j * n + i] - sum;
+                let (from, l_j) = (first_i.max(first[j]), l_base(j));
+                let sum: f64 = (from..j).map(|m| lu[l_j + m] * lu[u_i + m]).sum();
+                lu[u_i + j] = k[j * n + i] - sum;
             }
             for j in first_i..i {
-                let from = first_i.max(self.first[j]);
-                let sum: f64 = (from..j).map(|m| self.l(i, m) * self.u(m, j)).sum();
-                let at = self.start[i] + (j - first_i);
-                self.lu[at] = (k[i * n + j] - sum) / self.u(j, j);
+                let (from, u_j) = (first_i.max(first[j]), u_base(j));
+                let sum: f64 = (from..j).map(|m| lu[l_i + m] * lu[u_j + m]).sum();
+                lu[l_i + j] = (k[i * n + j] - sum) / lu[u_j + j];
             }
-            let sum: f64 = (first_i..i).map(|m| self.l(i, m) * self.u(m, i)).sum();
+            let sum: f64 = (first_i..i).map(|m| lu[l_i + m] * lu[u_i + m]).sum();
             let pivot = k[i * n + i] - sum;
             if pivot.abs() <= min_pivot || !pivot.is_finite() {
                 return false;
             }
-            self.lu[self.start[i] + 2 * width] = pivot;
+            lu[u_i + i] = pivot;
         }
         true
     }
