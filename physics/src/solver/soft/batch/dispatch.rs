@@ -56,7 +56,14 @@ impl LanePath {
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn has_avx2_and_fma() -> bool {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        std::arch::is_x86_feature_detected!("avx2") && Self::has_fma()
+    }
+
+    /// Whether the processor fuses a multiply and an add in one instruction.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    pub(in crate::solver::soft) fn has_fma() -> bool {
+        std::arch::is_x86_feature_detected!("fma")
     }
 
     /// Every path this processor runs, the portable one first.
