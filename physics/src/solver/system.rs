@@ -230,7 +230,7 @@ pub(crate) fn velocity_rows(
 /// Fills the dense symmetric `A = J M⁻¹ Jᵀ` (row-major, n×n) of `rows`.
 pub(crate) fn assemble(rows: &[Row], bodies: &[SolverBody], a: &mut Vec<f64>) {
     let n = rows.len();
-    a.clear();
+    // Every entry is written below: the old ones need no zeroing first.
     a.resize(n * n, 0.0);
     for p in 0..n {
         for q in p..n {
