@@ -25,6 +25,14 @@ fn neighbour_share(radii: &[f64], i: usize, j: usize) -> f64 {
     }
 }
 
+/// Whether `body` is where `pose` was taken, to the last bit.
+fn same_place(pose: &Pose, body: &Body) -> bool {
+    let bits = |x: f64| x.to_bits();
+    bits(pose.position.x) == bits(body.position.x)
+        && bits(pose.position.y) == bits(body.position.y)
+        && bits(pose.angle) == bits(body.angle)
+}
+
 /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
 /// `pairs`, counted by `neighbour_share` into `room_taken`.
 fn crowded(pairs: &[(u32, u32)], fixed: &[bool], radii: &[f64], room_taken: &mut Vec<f64>) -> bool {
@@ -175,6 +183,7 @@ impl World {
         let kept = &mut self.kept_pairs;
         s.polygons
             .resize_with(self.bodies.len(), WorldPolygon::default);
+        s.outlined_at.resize(self.bodies.len(), None);
         s.boxes.clear();
         s.reach.clear();
         s.motion.clear();
@@ -187,8 +196,9 @@ impl World {
         // as the bounds are made, in the one pass over the bodies.
         let mut still_inside = kept.bounds.len() == self.bodies.len();
         let mut same_fixed = kept.fixed.len() == self.bodies.len();
-        let bodies = self.bodies.iter().zip(s.polygons.iter_mut()).enumerate();
-        for (i, (body, polygon)) in bodies {
+        let bodies = self.bodies.iter().zip(s.polygons.iter_mut());
+        let bodies = bodies.zip(s.outlined_at.iter_mut()).enumerate();
+        for (i, ((body, polygon), outlined_at)) in bodies {
             // The speed of its farthest point from the spin alone.
             let spin = body
                 .as_ref()
@@ -197,13 +207,22 @@ impl World {
             let reach = (velocity.norm() + spin) * dt;
             s.reach.push(reach);
             s.motion.push((velocity * dt, spin * dt));
-            let pose = body.as_ref().map_or(Pose::default(), Pose::of);
-            s.poses.push(pose);
-            let bounds = body.as_ref().map(|b| {
-                // The outline from the pose (one rotation per body, shared with reuse).
-                polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
-                polygon.aabb().grown(0.5 * margin + reach)
+            let pose = body.as_ref().map_or(Pose::default(), |b| {
+                // A body where it was when its outline was last made (a static one, one
+                // asleep, one at rest to the last bit) keeps that outline, its normals
+                // and its pose: the same numbers, without turning it again.
+                let unmoved = outlined_at.is_some_and(|at| same_place(&at, b));
+                if !unmoved {
+                    let pose = Pose::of(b);
+                    polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
+                    *outlined_at = Some(pose);
+                }
+                outlined_at.expect("set above")
             });
+            s.poses.push(pose);
+            let bounds = body
+                .as_ref()
+                .map(|_| polygon.aabb().grown(0.5 * margin + reach));
             if still_inside {
                 still_inside = match (&bounds, &kept.bounds[i]) {
                     (Some(now), Some(fat)) => fat.contains(now),

@@ -229,6 +229,8 @@ struct Scratch {
     wake_broad_phase: BroadPhase,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
+    /// Per body: the pose its outline in `polygons` was made at (`find_candidate_pairs`).
+    outlined_at: Vec<Option<Pose>>,
     poses: Vec<Pose>,
     boxes: Vec<Option<Aabb>>,
     broad_phase: BroadPhase,
