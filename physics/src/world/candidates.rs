@@ -207,22 +207,21 @@ impl World {
             let reach = (velocity.norm() + spin) * dt;
             s.reach.push(reach);
             s.motion.push((velocity * dt, spin * dt));
-            let pose = body.as_ref().map_or(Pose::default(), |b| {
+            let outline = body.as_ref().map(|b| {
                 // A body where it was when its outline was last made (a static one, one
-                // asleep, one at rest to the last bit) keeps that outline, its normals
-                // and its pose: the same numbers, without turning it again.
-                let unmoved = outlined_at.is_some_and(|at| same_place(&at, b));
+                // asleep, one at rest to the last bit) keeps that outline, its normals,
+                // its pose and its bounds: the same numbers, without turning it again.
+                let unmoved = outlined_at.is_some_and(|(at, _)| same_place(&at, b));
                 if !unmoved {
                     let pose = Pose::of(b);
                     polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
-                    *outlined_at = Some(pose);
+                    *outlined_at = Some((pose, polygon.aabb()));
                 }
                 outlined_at.expect("set above")
             });
-            s.poses.push(pose);
-            let bounds = body
-                .as_ref()
-                .map(|_| polygon.aabb().grown(0.5 * margin + reach));
+            s.poses
+                .push(outline.map_or(Pose::default(), |(pose, _)| pose));
+            let bounds = outline.map(|(_, aabb)| aabb.grown(0.5 * margin + reach));
             if still_inside {
                 still_inside = match (&bounds, &kept.bounds[i]) {
                     (Some(now), Some(fat)) => fat.contains(now),

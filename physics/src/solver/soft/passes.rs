@@ -60,20 +60,22 @@ impl SoftStepSolver {
     /// The rest's bodies' velocities (those no chunk moves).
     pub(super) fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
         let chunked = self.chunks_apart() > 0;
-        let bodies = self.bodies.iter_mut().zip(accelerations).enumerate();
-        for (i, (b, &acceleration)) in bodies {
+        for &i in &self.in_motion {
+            let (i, b) = (i as usize, &mut self.bodies[i as usize]);
             if b.moves() && !(chunked && self.plan.in_chunk(i)) {
-                integrate_velocity(b, acceleration, h);
+                integrate_velocity(b, accelerations[i], h);
             }
         }
     }
 
-    /// The rest's bodies' positions (those no chunk moves).
+    /// The rest's bodies' positions (those no chunk moves). A body at rest and fixed
+    /// would stay where it is to the last bit: only `in_motion` is walked.
     pub(super) fn integrate_positions(&mut self, h: f64) {
         let chunked = self.chunks_apart() > 0;
-        for (i, b) in self.bodies.iter_mut().enumerate() {
+        for &i in &self.in_motion {
+            let i = i as usize;
             if !(chunked && self.plan.in_chunk(i)) {
-                integrate_position(b, h);
+                integrate_position(&mut self.bodies[i], h);
             }
         }
     }

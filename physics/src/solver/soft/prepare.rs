@@ -34,8 +34,9 @@ impl SoftStepSolver {
     /// joins.
     fn load_bodies(&mut self, bodies: &[SolverBody], joints: &[JointConstraint]) {
         self.bodies.clear();
+        self.in_motion.clear();
         let mut a_fixed_body_moves = false;
-        self.bodies.extend(bodies.iter().map(|b| {
+        self.bodies.extend(bodies.iter().enumerate().map(|(i, b)| {
             let body = SoftBody {
                 v: b.velocity,
                 w: b.angular_velocity,
@@ -45,7 +46,11 @@ impl SoftStepSolver {
                 dq: Rot { cos: 1.0, sin: 0.0 },
                 dangle: 0.0,
             };
-            a_fixed_body_moves |= !body.moves() && (body.v != Vec2::zeros() || body.w != 0.0);
+            let has_velocity = body.v != Vec2::zeros() || body.w != 0.0;
+            a_fixed_body_moves |= !body.moves() && has_velocity;
+            if body.moves() || has_velocity {
+                self.in_motion.push(i as u32);
+            }
             body
         }));
         self.a_fixed_body_moves = a_fixed_body_moves;
