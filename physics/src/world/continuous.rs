@@ -2,8 +2,9 @@
 //! goes back along its path to its time of impact, its joint island with it.
 
 use super::World;
+use crate::body::Body;
+use crate::collide::Aabb;
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
-use crate::collide::{Aabb, WorldPolygon};
 
 impl World {
     /// Continuous collision: see `step`.
@@ -52,12 +53,18 @@ impl World {
                         continue;
                     };
                     if obstacles.len() == n {
-                        obstacles.push((0, WorldPolygon::default(), Aabb::default()));
+                        obstacles.push(Default::default());
                     }
-                    let (index, polygon, bounds) = &mut obstacles[n];
-                    *index = slot as u32;
-                    polygon.update(obstacle);
-                    *bounds = polygon.aabb();
+                    let (index, polygon, bounds, placed_at) = &mut obstacles[n];
+                    // The same static body where it was placed last time has the same
+                    // outline: a terrain of many is not turned again at every fast body.
+                    let place = place_of(obstacle);
+                    if *index != slot as u32 || *placed_at != place || polygon.vertices.is_empty() {
+                        *index = slot as u32;
+                        polygon.update(obstacle);
+                        *bounds = polygon.aabb();
+                        *placed_at = place;
+                    }
                     n += 1;
                 }
                 n
@@ -73,7 +80,7 @@ impl World {
             // none at all), and placing both cost 7% of the smash's step.
             let (mut placed_at_end, mut placed_at_start) = (false, false);
             let mut first: Option<f64> = None;
-            for (obstacle, polygon, bounds) in &obstacles[..count] {
+            for (obstacle, polygon, bounds, _) in &obstacles[..count] {
                 if !swept.overlaps(bounds) {
                     continue;
                 }
@@ -194,4 +201,9 @@ impl World {
             (body.position, body.angle) = sweep.at(t);
         }
     }
+}
+
+/// A body's position and angle, to the last bit: whether it is where it was.
+fn place_of(body: &Body) -> [u64; 3] {
+    [body.position.x, body.position.y, body.angle].map(f64::to_bits)
 }

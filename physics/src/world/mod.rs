@@ -268,7 +268,7 @@ struct Scratch {
     toi_scratch: WorldPolygon,
     /// Continuous collision: static bodies' slots, outlines and bounds; the bodies
     /// stopped and their times of impact; joint islands and each island's earliest impact.
-    obstacles: Vec<(u32, WorldPolygon, Aabb)>,
+    obstacles: Vec<(u32, WorldPolygon, Aabb, [u64; 3])>,
     impacts: Vec<(u32, f64)>,
     impact_union: UnionFind,
     island_impact: Vec<f64>,
