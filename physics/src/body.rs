@@ -318,6 +318,12 @@ impl Body {
         &self.local_vertices
     }
 
+    /// Its position and angle bit for bit: equal to an earlier one exactly when the body
+    /// is where it was then, so that what was computed from its pose still holds.
+    pub(crate) fn place(&self) -> [u64; 3] {
+        [self.position.x, self.position.y, self.angle].map(f64::to_bits)
+    }
+
     pub(crate) fn rotation(&self) -> Rot {
         Rot::new(self.angle)
     }

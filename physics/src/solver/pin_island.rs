@@ -61,10 +61,7 @@ impl PinIsland {
     /// and which of them move: it is kept while those stay (an island is laid out several
     /// times a substep), and only the arms are turned afresh.
     fn lay_out(&mut self, joints: &[JointConstraint], bodies: &[SolverBody]) {
-        let moves = |slot: u32| {
-            let b = &bodies[slot as usize];
-            b.inv_mass != 0.0 || b.inv_inertia != 0.0
-        };
+        let moves = |slot: u32| bodies[slot as usize].moves();
         let key = |j: &JointConstraint| (j.body_a, j.body_b, moves(j.body_a), moves(j.body_b));
         let same = self.layout_key.len() == joints.len()
             && self
@@ -105,10 +102,7 @@ impl PinIsland {
                 .iter()
                 .map(|j| (place(j.body_a, &self.slots), place(j.body_b, &self.slots))),
         );
-        let moves = |slot: u32| {
-            let b = &bodies[slot as usize];
-            b.inv_mass != 0.0 || b.inv_inertia != 0.0
-        };
+        let moves = |slot: u32| bodies[slot as usize].moves();
         self.on_body.clear();
         for (q, &(a, b)) in self.ends.iter().enumerate() {
             for end in [a, b] {

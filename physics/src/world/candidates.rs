@@ -25,14 +25,6 @@ fn neighbour_share(radii: &[f64], i: usize, j: usize) -> f64 {
     }
 }
 
-/// Whether `body` is where `pose` was taken, to the last bit.
-fn same_place(pose: &Pose, body: &Body) -> bool {
-    let bits = |x: f64| x.to_bits();
-    bits(pose.position.x) == bits(body.position.x)
-        && bits(pose.position.y) == bits(body.position.y)
-        && bits(pose.angle) == bits(body.angle)
-}
-
 /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
 /// `pairs`, counted by `neighbour_share` into `room_taken`.
 fn crowded(pairs: &[(u32, u32)], fixed: &[bool], radii: &[f64], room_taken: &mut Vec<f64>) -> bool {
@@ -211,17 +203,17 @@ impl World {
                 // A body where it was when its outline was last made (a static one, one
                 // asleep, one at rest to the last bit) keeps that outline, its normals,
                 // its pose and its bounds: the same numbers, without turning it again.
-                let unmoved = outlined_at.is_some_and(|(at, _)| same_place(&at, b));
-                if !unmoved {
+                let place = b.place();
+                if outlined_at.is_none_or(|(at, ..)| at != place) {
                     let pose = Pose::of(b);
                     polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
-                    *outlined_at = Some((pose, polygon.aabb()));
+                    *outlined_at = Some((place, pose, polygon.aabb()));
                 }
                 outlined_at.expect("set above")
             });
             s.poses
-                .push(outline.map_or(Pose::default(), |(pose, _)| pose));
-            let bounds = outline.map(|(_, aabb)| aabb.grown(0.5 * margin + reach));
+                .push(outline.map_or(Pose::default(), |(_, pose, _)| pose));
+            let bounds = outline.map(|(.., aabb)| aabb.grown(0.5 * margin + reach));
             if still_inside {
                 still_inside = match (&bounds, &kept.bounds[i]) {
                     (Some(now), Some(fat)) => fat.contains(now),

@@ -2,7 +2,6 @@
 //! goes back along its path to its time of impact, its joint island with it.
 
 use super::World;
-use crate::body::Body;
 use crate::collide::Aabb;
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
 
@@ -58,7 +57,7 @@ impl World {
                     let (index, polygon, bounds, placed_at) = &mut obstacles[n];
                     // The same static body where it was placed last time has the same
                     // outline: a terrain of many is not turned again at every fast body.
-                    let place = place_of(obstacle);
+                    let place = obstacle.place();
                     if *index != slot as u32 || *placed_at != place || polygon.vertices.is_empty() {
                         *index = slot as u32;
                         polygon.update(obstacle);
@@ -201,9 +200,4 @@ impl World {
             (body.position, body.angle) = sweep.at(t);
         }
     }
-}
-
-/// A body's position and angle, to the last bit: whether it is where it was.
-fn place_of(body: &Body) -> [u64; 3] {
-    [body.position.x, body.position.y, body.angle].map(f64::to_bits)
 }

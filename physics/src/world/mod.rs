@@ -229,9 +229,9 @@ struct Scratch {
     wake_broad_phase: BroadPhase,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
-    /// Per body: the pose its outline in `polygons` was made at, and the outline's bounds
-    /// (`find_candidate_pairs`).
-    outlined_at: Vec<Option<(Pose, Aabb)>>,
+    /// Per body: the place (`Body::place`) and pose its outline in `polygons` was made
+    /// at, and the outline's bounds (`find_candidate_pairs`).
+    outlined_at: Vec<Option<([u64; 3], Pose, Aabb)>>,
     poses: Vec<Pose>,
     boxes: Vec<Option<Aabb>>,
     broad_phase: BroadPhase,
