@@ -6,6 +6,7 @@ use super::{NormalBlock, PointConstraint, SoftBody};
 use crate::math::{Rot, Vec2, clamp, cross, greater, lesser, perp};
 
 /// Re-applies a point's accumulated impulses at the start of a substep.
+#[inline(always)]
 pub(super) fn warm_start_point(bodies: &mut [SoftBody], p: &PointConstraint) {
     let mut pair = BodyPair::load(bodies, p.a, p.b);
     pair.apply_along(p.normal, p.levers.normal, p.normal_impulse);
@@ -191,6 +192,7 @@ pub(super) fn sinking_floor(separation: f64, pass: &PassSettings) -> f64 {
     lesser(-(pass.max_depth + separation) * pass.inv_h, 0.0)
 }
 
+#[inline(always)]
 pub(super) fn solve_point(bodies: &mut [SoftBody], p: &mut PointConstraint, pass: &PassSettings) {
     let (target, softness, separation) = point_target(bodies, p, pass);
     let mut pair = BodyPair::load(bodies, p.a, p.b);
@@ -240,6 +242,7 @@ pub(super) fn solve_friction(pair: &mut BodyPair, p: &mut PointConstraint) {
 /// Two points of one manifold: normals together where both rows are rigid (the relax
 /// pass, or both points speculative: `solve_normal_pair`), point by point where a row is
 /// a soft spring; then friction point by point.
+#[inline(always)]
 pub(super) fn solve_pair(
     bodies: &mut [SoftBody],
     (p, q): (&mut PointConstraint, &mut PointConstraint),

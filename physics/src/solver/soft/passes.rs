@@ -2,13 +2,13 @@
 //! and the biased and relaxed solves swept over the plan's items, chunk by chunk and
 //! then the rest.
 
-use super::batch::{AskedFor, LaneBatch, LanePath, PassItem, PassSettings};
+use super::batch::{AskedFor, LaneBatch, LanePath, ManifoldBatch, PassItem, PassSettings};
 use super::contacts::{solve_pair, solve_point, warm_start_point};
 use super::joints::{solve_joint, solve_motor, warm_start_motor, warm_start_pin};
 use super::pins::{PinPass, PinPlan};
 use super::{
-    MAX_TURN_PER_SUBSTEP, SoftBody, SoftSettings, SoftStepSolver, Softness, SweepOrder,
-    contact_pass,
+    MAX_TURN_PER_SUBSTEP, PointConstraint, SoftBody, SoftSettings, SoftStepSolver, Softness,
+    SweepOrder, contact_pass,
 };
 use crate::math::{Rot, Vec2, clamp};
 use std::ops::Range;
@@ -115,13 +115,29 @@ impl SoftStepSolver {
 
     /// Warm-starts the plan's `items`, in their order.
     pub(super) fn warm_start_items(&mut self, items: Range<usize>, ask: bool) {
+        // The points' fused multiply–adds as one instruction where the processor has FMA
+        // (as in `build_points`): the same bits either way.
+        #[cfg(target_arch = "x86_64")]
+        if LanePath::has_fma() {
+            // SAFETY: the processor has FMA, checked just above.
+            return unsafe { self.warm_start_items_with_fma(items, ask) };
+        }
+        self.warm_start_items_inline(items, ask)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "fma")]
+    unsafe fn warm_start_items_with_fma(&mut self, items: Range<usize>, ask: bool) {
+        self.warm_start_items_inline(items, ask)
+    }
+
+    #[inline(always)]
+    fn warm_start_items_inline(&mut self, items: Range<usize>, ask: bool) {
         let (batches, point_batches) = (self.plan.batches(), self.plan.point_batches());
         let lanes = LanePath::best();
         let ahead = self.plan.batches_ahead().only_if(ask);
-        ahead.visit(
-            self.plan.items[items].iter(),
-            AskedFor::WarmStart,
-            |item| match *item {
+        for item in ahead.asking(self.plan.items[items].iter(), AskedFor::WarmStart) {
+            match *item {
                 PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
                 PassItem::PointBatch(k) => {
                     point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
@@ -132,13 +148,42 @@ impl SoftStepSolver {
                         warm_start_point(&mut self.bodies, p);
                     }
                 }
-            },
-        );
+            }
+        }
     }
 
     /// One pass over the plan's `items`, in their order or backwards: eight manifolds at
-    /// a time where they are batched (see `batch`).
+    /// a time where they are batched (see `batch`), the rest with FMA where the processor
+    /// has it (as `warm_start_items`).
     pub(super) fn sweep_items(
+        &mut self,
+        items: Range<usize>,
+        pass: &PassSettings,
+        order: SweepOrder,
+        ask: bool,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if LanePath::has_fma() {
+            // SAFETY: the processor has FMA, checked just above.
+            return unsafe { self.sweep_items_with_fma(items, pass, order, ask) };
+        }
+        self.sweep_items_inline(items, pass, order, ask)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "fma")]
+    unsafe fn sweep_items_with_fma(
+        &mut self,
+        items: Range<usize>,
+        pass: &PassSettings,
+        order: SweepOrder,
+        ask: bool,
+    ) {
+        self.sweep_items_inline(items, pass, order, ask)
+    }
+
+    #[inline(always)]
+    fn sweep_items_inline(
         &mut self,
         items: Range<usize>,
         pass: &PassSettings,
@@ -148,24 +193,19 @@ impl SoftStepSolver {
         let ahead = self.plan.batches_ahead().only_if(ask);
         let (all_items, batches, point_batches) = self.plan.work();
         let items = &all_items[items];
-        let lanes = LanePath::best();
-        let solve_item = |item: &PassItem| match *item {
-            PassItem::Batch(k) => batches[k as usize].solve_on(lanes, &mut self.bodies, pass),
-            PassItem::PointBatch(k) => {
-                point_batches[k as usize].solve_on(lanes, &mut self.bodies, pass)
-            }
-            PassItem::Manifold(first, 2) => {
-                let i = first as usize;
-                let (first, second) = self.points.split_at_mut(i + 1);
-                solve_pair(&mut self.bodies, (&mut first[i], &mut second[0]), pass);
-            }
-            PassItem::Manifold(first, _) => {
-                solve_point(&mut self.bodies, &mut self.points[first as usize], pass)
-            }
-        };
+        let work = (
+            batches,
+            point_batches,
+            &mut self.bodies[..],
+            &mut self.points[..],
+        );
         match order {
-            SweepOrder::Forwards => ahead.visit(items.iter(), AskedFor::Pass, solve_item),
-            SweepOrder::Backwards => ahead.visit(items.iter().rev(), AskedFor::Pass, solve_item),
+            SweepOrder::Forwards => {
+                sweep_in_order(ahead.asking(items.iter(), AskedFor::Pass), work, pass)
+            }
+            SweepOrder::Backwards => {
+                sweep_in_order(ahead.asking(items.iter().rev(), AskedFor::Pass), work, pass)
+            }
         }
     }
 
@@ -220,5 +260,36 @@ impl SoftStepSolver {
         let (rest, coloured_from) = (self.rest_items(), self.plan.coloured_from);
         self.sweep_items(0..coloured_from, &pass, SweepOrder::Forwards, true);
         self.sweep_items(coloured_from..rest.end, &pass, order, true);
+    }
+}
+
+/// What a pass works on: the batches of pairs and of single points, the bodies and the
+/// points.
+type PassWork<'w> = (
+    &'w mut [ManifoldBatch<2>],
+    &'w mut [ManifoldBatch<1>],
+    &'w mut [SoftBody],
+    &'w mut [PointConstraint],
+);
+
+/// Solves each of `items` once, in the order given.
+#[inline(always)]
+fn sweep_in_order<'a>(
+    items: impl Iterator<Item = &'a PassItem>,
+    (batches, point_batches, bodies, points): PassWork,
+    pass: &PassSettings,
+) {
+    let lanes = LanePath::best();
+    for item in items {
+        match *item {
+            PassItem::Batch(k) => batches[k as usize].solve_on(lanes, bodies, pass),
+            PassItem::PointBatch(k) => point_batches[k as usize].solve_on(lanes, bodies, pass),
+            PassItem::Manifold(first, 2) => {
+                let i = first as usize;
+                let (first, second) = points.split_at_mut(i + 1);
+                solve_pair(bodies, (&mut first[i], &mut second[0]), pass);
+            }
+            PassItem::Manifold(first, _) => solve_point(bodies, &mut points[first as usize], pass),
+        }
     }
 }

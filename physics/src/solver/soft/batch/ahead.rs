@@ -42,19 +42,19 @@ impl BatchesAhead {
         self
     }
 
-    /// Hands `items` to `visit` in their order, asking for what `reader` will read of
-    /// each next one's batch while the one before is visited.
+    /// `items` in their order, asking for what `reader` will read of each next one's
+    /// batch as the one before is handed out. An iterator rather than a callback, so that
+    /// the pass's own loop is compiled with the features of the function it is in.
     #[inline(always)]
-    pub(crate) fn visit<'a>(
+    pub(crate) fn asking<'a, I: Iterator<Item = &'a PassItem>>(
         self,
-        items: impl Iterator<Item = &'a PassItem>,
+        items: I,
         reader: AskedFor,
-        mut visit: impl FnMut(&'a PassItem),
-    ) {
-        let mut items = items.peekable();
-        while let Some(item) = items.next() {
-            self.ask_for(items.peek().copied(), reader);
-            visit(item);
+    ) -> Asking<'a, I> {
+        Asking {
+            ahead: self,
+            items: items.peekable(),
+            reader,
         }
     }
 
@@ -151,5 +151,23 @@ impl<const N: usize> ManifoldBatch<N> {
             at(offset_of!(Self, normal_impulses)),
             N * size_of::<F64x8>(),
         );
+    }
+}
+
+/// `BatchesAhead::asking`'s items.
+pub(in crate::solver::soft) struct Asking<'a, I: Iterator<Item = &'a PassItem>> {
+    ahead: BatchesAhead,
+    items: std::iter::Peekable<I>,
+    reader: AskedFor,
+}
+
+impl<'a, I: Iterator<Item = &'a PassItem>> Iterator for Asking<'a, I> {
+    type Item = &'a PassItem;
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<&'a PassItem> {
+        let item = self.items.next()?;
+        self.ahead.ask_for(self.items.peek().copied(), self.reader);
+        Some(item)
     }
 }
