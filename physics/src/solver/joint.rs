@@ -1,7 +1,7 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
 use super::SolverBody;
-use super::island::{UnionFind, group_by_island};
+use super::island::IslandGrouping;
 use super::pin_island::{PinIsland, displace_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
@@ -311,8 +311,9 @@ pub(crate) struct JointBlockSolver {
 /// The joints grouped into islands, one island's copied out at a time.
 #[derive(Debug, Clone, Default)]
 struct JointIslands {
-    uf: UnionFind,
-    grouped: Vec<(u32, u32)>,
+    /// The joints' islands, kept while the joints and the moving bodies are the same (a
+    /// chain's are found once, not at every pass of every substep).
+    grouping: IslandGrouping,
     island: Vec<JointConstraint>,
 }
 
@@ -429,31 +430,25 @@ impl JointIslands {
         bodies: &mut [SolverBody],
         mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
     ) {
-        let dynamic = |slot: u32| bodies[slot as usize].moves();
-        group_by_island(
+        let grouped = self.grouping.group(
             joints.len(),
             bodies.len(),
             |i| (joints[i].body_a, joints[i].body_b),
-            dynamic,
-            &mut self.uf,
-            &mut self.grouped,
+            |slot| bodies[slot as usize].moves(),
         );
         let mut start = 0;
-        while start < self.grouped.len() {
-            let root = self.grouped[start].0;
+        while start < grouped.len() {
+            let root = grouped[start].0;
             let end = start
-                + self.grouped[start..]
+                + grouped[start..]
                     .iter()
                     .take_while(|(r, _)| *r == root)
                     .count();
             self.island.clear();
-            self.island.extend(
-                self.grouped[start..end]
-                    .iter()
-                    .map(|&(_, i)| joints[i as usize]),
-            );
+            self.island
+                .extend(grouped[start..end].iter().map(|&(_, i)| joints[i as usize]));
             solve(&mut self.island, bodies);
-            for (k, &(_, i)) in self.grouped[start..end].iter().enumerate() {
+            for (k, &(_, i)) in grouped[start..end].iter().enumerate() {
                 joints[i as usize] = self.island[k];
             }
             start = end;

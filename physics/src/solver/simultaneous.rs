@@ -4,7 +4,7 @@
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
-use super::island::{UnionFind, group_by_island};
+use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
@@ -72,8 +72,9 @@ pub(crate) enum FrictionModel {
 /// Buffers reused across steps.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SimultaneousSolver {
-    uf: UnionFind,
-    grouped: Vec<(u32, u32)>,
+    /// The contacts' and joints' islands, kept while the items and the moving bodies are
+    /// the same (the passes of one substep find them once).
+    grouping: IslandGrouping,
     /// Each island's span of `grouped`.
     ranges: Vec<(usize, usize)>,
     contact_count: usize,
@@ -353,21 +354,16 @@ impl SimultaneousSolver {
                 (joints[i - nc].body_a, joints[i - nc].body_b)
             }
         };
-        group_by_island(
-            nc + joint_count,
-            bodies.len(),
-            ends,
-            dynamic,
-            &mut self.uf,
-            &mut self.grouped,
-        );
+        let grouped = self
+            .grouping
+            .group(nc + joint_count, bodies.len(), ends, dynamic);
         self.contact_count = nc;
         self.ranges.clear();
         let mut start = 0;
-        while start < self.grouped.len() {
-            let root = self.grouped[start].0;
+        while start < grouped.len() {
+            let root = grouped[start].0;
             let end = start
-                + self.grouped[start..]
+                + grouped[start..]
                     .iter()
                     .take_while(|(r, _)| *r == root)
                     .count();
@@ -383,7 +379,7 @@ impl SimultaneousSolver {
         self.island_contacts.clear();
         self.island_joints.clear();
         self.joint_slots.clear();
-        for &(_, item) in &self.grouped[start..end] {
+        for &(_, item) in &self.grouping.grouped()[start..end] {
             let item = item as usize;
             if item < nc {
                 self.island_contacts.push((item as u32, contacts[item]));
