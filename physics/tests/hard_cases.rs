@@ -43,6 +43,70 @@ fn without_continuous_collision_the_soft_step_lets_a_spinning_body_through() {
     );
 }
 
+/// The step keeps what it made from a body that has not moved (its outline, its bounds,
+/// continuous collision's obstacles). A static body moved by hand between steps must be
+/// met where it is now: a box resting on a floor that is pulled away falls, and a fast
+/// box meets a wall moved into its path after it was first outlined far away.
+#[test]
+fn a_static_body_moved_by_hand_is_met_where_it_now_is() {
+    for solver in SOLVERS {
+        let mut w = World::new(Vec2::new(0.0, 10.0));
+        w.settings.contact_solver = solver;
+        let floor = ConvexPolygon::rectangle(4.0, 1.0).unwrap();
+        let floor = w
+            .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
+            .unwrap();
+        let crate_ = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        let crate_ = w
+            .add_body(BodyDef::new(crate_, 1.0).at(Vec2::new(0.0, -0.5), 0.0))
+            .unwrap();
+        for _ in 0..60 {
+            w.step(H);
+        }
+        let rest = w.body(crate_).unwrap().position.y;
+        assert!((rest + 0.5).abs() < 0.01, "{solver:?}: rests at {rest}");
+        w.body_mut(floor).unwrap().position.x += 100.0;
+        for _ in 0..30 {
+            w.step(H);
+        }
+        // Half a second of free fall from rest: 1.25 m.
+        let fallen = w.body(crate_).unwrap().position.y - rest;
+        assert!(
+            fallen > 1.2,
+            "{solver:?}: fell {fallen} m with the floor gone"
+        );
+    }
+    for solver in SOLVERS {
+        let mut w = World::new(Vec2::new(0.0, 0.0));
+        w.settings.contact_solver = solver;
+        w.settings.length_scale = 0.1;
+        let wall = ConvexPolygon::rectangle(0.02, 50.0).unwrap();
+        let wall = w
+            .add_body(BodyDef::new(wall, 0.0).at(Vec2::new(500.0, 0.0), 0.0))
+            .unwrap();
+        let bullet = ConvexPolygon::rectangle(0.1, 0.1).unwrap();
+        let bullet = w
+            .add_body(
+                BodyDef::new(bullet, 1.0)
+                    .at(Vec2::new(-30.0, 0.0), 0.1)
+                    .velocity(Vec2::new(1000.0, 0.0), -300.0),
+            )
+            .unwrap();
+        w.step(H);
+        let x = w.body(bullet).unwrap().position.x;
+        w.body_mut(wall).unwrap().position.x = x + 5.0;
+        for step in 0..30 {
+            w.step(H);
+            let b = w.body(bullet).unwrap();
+            assert!(
+                b.position.x < x + 5.0,
+                "{solver:?}: through the moved wall at step {step} (x = {})",
+                b.position.x
+            );
+        }
+    }
+}
+
 fn fast_bodies_against_a_thin_wall(solvers: &[ContactSolver], continuous: bool) {
     // A 0.1 box against a wall 0.02 thick, at up to 1000 m/s: 170 of its widths per step.
     // Speculative contacts see the wall as soon as it is within this step's reach. The
