@@ -3,19 +3,17 @@
 //! `cargo run --release -p pe --example chain_profile -- exact 600 [links]`.
 //! Prints the time per step, the widest any pin opened, and a hash of the final state
 //! (to check that a change leaves the trajectory bit for bit).
-use pe::{BodyDef, ContactSolver, ConvexPolygon, JointDef, Vec2, World};
+use pe::{BodyDef, ConvexPolygon, JointDef, Vec2, World};
 use std::time::Instant;
+
+#[path = "support/profile_args.rs"]
+mod profile_args;
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let name = args.next().unwrap_or_else(|| "exact".into());
-    let Some(solver) = ContactSolver::from_name(&name) else {
-        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
-        eprintln!("unknown solver {name:?}: one of {}", names.join(", "));
-        std::process::exit(2);
-    };
-    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
-    let links: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(10);
+    let solver = profile_args::solver(&mut args, "exact");
+    let steps = profile_args::count(&mut args, 600);
+    let links = profile_args::count(&mut args, 10);
     let mut w = World::new(Vec2::new(0.0, 10.0));
     w.settings.contact_solver = solver;
     let link = ConvexPolygon::rectangle(1.0, 0.1).unwrap();
@@ -42,16 +40,7 @@ fn main() {
         }
     }
     let per_step = started.elapsed().as_secs_f64() / steps as f64;
-    let mut hash: u64 = 0;
-    for (_, b) in w.bodies() {
-        let state = [b.position.x, b.position.y, b.angle];
-        for v in state
-            .into_iter()
-            .chain([b.velocity.x, b.velocity.y, b.angular_velocity])
-        {
-            hash = hash.rotate_left(5) ^ v.to_bits();
-        }
-    }
+    let hash = profile_args::state_hash(&w);
     println!(
         "{solver:?}: {links} links, {:.1} µs/step (mean of {steps}); widest pin gap {widest:.2e}; state {hash:016x}",
         per_step * 1e6

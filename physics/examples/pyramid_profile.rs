@@ -1,19 +1,17 @@
 //! A 20-row pyramid (210 unit boxes) under a chosen solver for profiling:
 //! `cargo run --release -p pe --example pyramid_profile -- soft 600 [rows] [fresh]`;
 //! `fresh` runs the separating-axis test on every pair every step (no manifold reuse).
-use pe::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
+use pe::{BodyDef, ConvexPolygon, Vec2, World};
 use std::time::Instant;
+
+#[path = "support/profile_args.rs"]
+mod profile_args;
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let name = args.next().unwrap_or_else(|| "soft".into());
-    let Some(solver) = ContactSolver::from_name(&name) else {
-        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
-        eprintln!("unknown solver {name:?}: one of {}", names.join(", "));
-        std::process::exit(2);
-    };
-    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
-    let rows: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let solver = profile_args::solver(&mut args, "soft");
+    let steps = profile_args::count(&mut args, 600);
+    let rows = profile_args::count(&mut args, 20);
     let fresh = args.next().as_deref() == Some("fresh");
     let mut w = World::new(Vec2::new(0.0, 10.0));
     w.settings.contact_solver = solver;

@@ -2,19 +2,17 @@
 //! spends on bodies that never move:
 //! `cargo run --release -p pe --example terrain_profile -- soft 600 2000`
 //! (solver, steps, tiles). Prints the time per step and a hash of the final state.
-use pe::{BodyDef, ContactSolver, ConvexPolygon, Vec2, World};
+use pe::{BodyDef, ConvexPolygon, Vec2, World};
 use std::time::Instant;
+
+#[path = "support/profile_args.rs"]
+mod profile_args;
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let name = args.next().unwrap_or_else(|| "auto".into());
-    let Some(solver) = ContactSolver::from_name(&name) else {
-        let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
-        eprintln!("unknown solver {name:?}: one of {}", names.join(", "));
-        std::process::exit(2);
-    };
-    let steps: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(600);
-    let tiles: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(2000);
+    let solver = profile_args::solver(&mut args, "auto");
+    let steps = profile_args::count(&mut args, 600);
+    let tiles = profile_args::count(&mut args, 2000);
     let mut w = World::new(Vec2::new(0.0, 10.0));
     w.settings.contact_solver = solver;
     let tile = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
@@ -31,12 +29,7 @@ fn main() {
         w.step(1.0 / 60.0);
     }
     let per_step = started.elapsed().as_secs_f64() / steps as f64;
-    let mut hash: u64 = 0;
-    for (_, b) in w.bodies() {
-        for v in b.state() {
-            hash = hash.rotate_left(5) ^ v.to_bits();
-        }
-    }
+    let hash = profile_args::state_hash(&w);
     println!(
         "{solver:?}: {tiles} static tiles, 10 boxes, {:.1} µs/step (mean of {steps}); state {hash:016x}",
         per_step * 1e6

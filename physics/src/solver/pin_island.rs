@@ -48,7 +48,7 @@ pub(super) struct PinIsland {
     saved: Vec<(usize, SolverBody)>,
     k: Vec<f64>,
     /// Each row of K's first column that may be nonzero: joint p's rows start at its
-    /// first coupled joint's.
+    /// first coupled joint's (part of the layout).
     k_first: Vec<usize>,
     /// The right-hand side, and then the impulses ψ.
     psi: Vec<f64>,
@@ -129,6 +129,12 @@ impl PinIsland {
             self.coupled.truncate(from + kept);
         }
         self.coupled_start.push(self.coupled.len());
+        self.k_first.clear();
+        for p in 0..joints.len() {
+            let coupled = &self.coupled[self.coupled_start[p]..self.coupled_start[p + 1]];
+            let first = 2 * coupled.first().map_or(p, |&q| q.min(p));
+            self.k_first.extend([first, first]);
+        }
     }
 
     /// The impulses that make `residual` zero for all joints of the island at once, to
@@ -176,12 +182,6 @@ impl PinIsland {
         let scale = (0..n).map(|i| self.k[i * n + i]).fold(0.0, f64::max);
         for i in 0..n {
             self.k[i * n + i] += 1e-12 * scale;
-        }
-        self.k_first.clear();
-        for p in 0..joints.len() {
-            let coupled = &self.coupled[self.coupled_start[p]..self.coupled_start[p + 1]];
-            let first = 2 * coupled.first().map_or(p, |&q| q.min(p));
-            self.k_first.extend([first, first]);
         }
         // Within K's envelope where its pivots stay well away from zero (a chain's K is
         // block tridiagonal: 2.4 -> 1.2 ms a step for 41 pins), densely with pivoting
