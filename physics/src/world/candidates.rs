@@ -138,6 +138,22 @@ impl KeptPairs {
     }
 }
 
+/// The slots whose bounds a step looks at: every one, or the awake bodies'.
+enum Slots<'a> {
+    Every(std::ops::Range<u32>),
+    Awake(std::slice::Iter<'a, u32>),
+}
+
+impl Iterator for Slots<'_> {
+    type Item = u32;
+    fn next(&mut self) -> Option<u32> {
+        match self {
+            Slots::Every(range) => range.next(),
+            Slots::Awake(slots) => slots.next().copied(),
+        }
+    }
+}
+
 impl World {
     pub(super) fn refresh_collision_filter(&mut self) {
         if !std::mem::take(&mut self.collision_filter_stale) {
@@ -171,34 +187,49 @@ impl World {
     /// candidate pairs: bodies whose bounds, grown by the margin and by how far each can
     /// move in `dt`, overlap (pairs of fixed bodies and pairs kept apart left out).
     pub(super) fn find_candidate_pairs(&mut self, dt: f64) {
+        self.sets.refresh(&self.bodies);
         let s = &mut self.scratch;
         let kept = &mut self.kept_pairs;
-        s.polygons
-            .resize_with(self.bodies.len(), WorldPolygon::default);
-        s.outlined_at.resize(self.bodies.len(), None);
-        s.boxes.clear();
-        s.reach.clear();
-        s.motion.clear();
-        s.poses.clear();
+        let n = self.bodies.len();
         let margin = self.settings.contact_margin();
         let is_fixed =
             |body: &Option<Body>| body.as_ref().is_none_or(|b| b.is_static() || b.is_asleep());
+        // Static and sleeping bodies keep what they were given when the sets last changed
+        // (their speed, if any, was counted at this step length and margin); the awake
+        // ones are looked at again.
+        let seen = (self.sets.epoch(), dt.to_bits(), margin.to_bits());
+        let every_body = s.bounds_seen != Some(seen) || s.boxes.len() != n;
+        if every_body {
+            s.bounds_seen = Some(seen);
+            s.polygons.resize_with(n, WorldPolygon::default);
+            s.outlined_at.resize(n, None);
+            s.boxes.resize(n, None);
+            s.reach.resize(n, 0.0);
+            s.motion.resize(n, (Vec2::zeros(), 0.0));
+            s.poses.resize(n, Pose::default());
+        }
         // The grown bounds' pairs still hold every pair whose bounds overlap now if every
         // body's bounds lie inside its grown ones, and the same bodies are fixed: checked
-        // as the bounds are made, in the one pass over the bodies.
-        let mut still_inside = kept.bounds.len() == self.bodies.len();
-        let mut same_fixed = kept.fixed.len() == self.bodies.len();
-        let bodies = self.bodies.iter().zip(s.polygons.iter_mut());
-        let bodies = bodies.zip(s.outlined_at.iter_mut()).enumerate();
-        for (i, ((body, polygon), outlined_at)) in bodies {
+        // as the bounds are made. Bodies not looked at are as they were when last checked.
+        let mut still_inside = kept.bounds.len() == n;
+        let mut same_fixed = kept.fixed.len() == n;
+        let looked_at = if every_body {
+            Slots::Every(0..n as u32)
+        } else {
+            Slots::Awake(self.sets.awake().iter())
+        };
+        for i in looked_at {
+            let i = i as usize;
+            let body = &self.bodies[i];
             // The speed of its farthest point from the spin alone.
             let spin = body
                 .as_ref()
                 .map_or(0.0, |b| b.angular_velocity.abs() * b.bounding_radius());
             let velocity = body.as_ref().map_or(Vec2::zeros(), |b| b.velocity);
             let reach = (velocity.norm() + spin) * dt;
-            s.reach.push(reach);
-            s.motion.push((velocity * dt, spin * dt));
+            s.reach[i] = reach;
+            s.motion[i] = (velocity * dt, spin * dt);
+            let (polygon, outlined_at) = (&mut s.polygons[i], &mut s.outlined_at[i]);
             let outline = body.as_ref().map(|b| {
                 // A body where it was when its outline was last made (a static one, one
                 // asleep, one at rest to the last bit) keeps that outline, its normals,
@@ -211,8 +242,7 @@ impl World {
                 }
                 outlined_at.expect("set above")
             });
-            s.poses
-                .push(outline.map_or(Pose::default(), |(_, pose, _)| pose));
+            s.poses[i] = outline.map_or(Pose::default(), |(_, pose, _)| pose);
             let bounds = outline.map(|(.., aabb)| aabb.grown(0.5 * margin + reach));
             if still_inside {
                 still_inside = match (&bounds, &kept.bounds[i]) {
@@ -222,7 +252,7 @@ impl World {
                 };
             }
             same_fixed = same_fixed && kept.fixed[i] == is_fixed(body);
-            s.boxes.push(bounds);
+            s.boxes[i] = bounds;
         }
         let bodies = &self.bodies;
         // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.

@@ -3,6 +3,7 @@
 //! module named for it.
 
 mod auto;
+mod body_sets;
 mod candidates;
 mod contacts;
 mod continuous;
@@ -16,6 +17,7 @@ pub(crate) mod stats;
 use settings::{Integrator, StepSettings};
 
 use auto::{AutoMemory, IslandNeeds};
+use body_sets::BodySets;
 use candidates::{KeptPairs, NeighbourScratch};
 use solver_bodies::GapTargets;
 use stats::StepStats;
@@ -163,6 +165,8 @@ const MAX_SUBSTEPS: usize = 8;
 #[derive(Debug, Clone, Default)]
 pub struct World {
     bodies: Vec<Option<Body>>,
+    /// The bodies' slots sorted into static, sleeping and awake.
+    sets: BodySets,
     pub gravity: Vec2,
     /// Friction coefficient for contacts whose bodies set none (the scene's `friction`).
     pub friction: f64,
@@ -227,6 +231,9 @@ struct Scratch {
     island_union: UnionFind,
     wake_labels: Vec<u32>,
     wake_broad_phase: BroadPhase,
+    /// Waking's own bounding boxes and reaches (its broad phase's).
+    wake_boxes: Vec<Option<Aabb>>,
+    wake_reach: Vec<f64>,
     island_ready: Vec<bool>,
     polygons: Vec<WorldPolygon>,
     /// Per body: the place (`Body::place`) and pose its outline in `polygons` was made
@@ -234,6 +241,9 @@ struct Scratch {
     outlined_at: Vec<Option<([u64; 3], Pose, Aabb)>>,
     poses: Vec<Pose>,
     boxes: Vec<Option<Aabb>>,
+    /// The sets' epoch, step length and contact margin (bits) that `boxes`, `reach`,
+    /// `motion` and `poses` of static and sleeping bodies were made with.
+    bounds_seen: Option<(u64, u64, u64)>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
     /// Each body's bounding radius, and scratch for keeping a crowded body's nearest
@@ -300,12 +310,15 @@ impl World {
     pub fn add_body(&mut self, def: BodyDef) -> Result<BodyHandle, BodyError> {
         let body = Body::new(def)?;
         self.bodies.push(Some(body));
+        self.sets.mark_changed();
         Ok(BodyHandle((self.bodies.len() - 1) as u32))
     }
 
     /// Removes a body; its handle then finds nothing. Returns the body if it existed.
     pub fn remove_body(&mut self, handle: BodyHandle) -> Option<Body> {
-        self.bodies.get_mut(handle.index())?.take()
+        let body = self.bodies.get_mut(handle.index())?.take()?;
+        self.sets.mark_changed();
+        Some(body)
     }
 
     pub fn body(&self, handle: BodyHandle) -> Option<&Body> {
@@ -313,7 +326,12 @@ impl World {
     }
 
     pub fn body_mut(&mut self, handle: BodyHandle) -> Option<&mut Body> {
-        self.bodies.get_mut(handle.index())?.as_mut()
+        let body = self.bodies.get_mut(handle.index())?.as_mut()?;
+        // An awake body is looked at again every step; another may now be moved by hand.
+        if body.is_static() || body.is_asleep() {
+            self.sets.mark_changed();
+        }
+        Some(body)
     }
 
     /// The median bounding radius of the bodies that can move (none: `None`): the size of
@@ -629,6 +647,7 @@ impl World {
             // Sleeping was switched off: wake everyone, once.
             self.bodies.iter_mut().flatten().for_each(Body::wake);
             self.sleep_labels.clear();
+            self.sets.mark_changed();
         }
     }
 

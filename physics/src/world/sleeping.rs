@@ -29,6 +29,7 @@ impl World {
                 b.wake();
             }
         }
+        self.sets.mark_changed();
     }
 
     /// Wakes sleeping islands that an awake body can reach this step, and those with a
@@ -39,8 +40,8 @@ impl World {
         let margin = self.settings.contact_margin();
         let mut wake = std::mem::take(&mut self.scratch.wake_labels);
         wake.clear();
-        let some_asleep = self.bodies.iter().flatten().any(|b| b.asleep);
-        let some_awake = self.bodies.iter().flatten().any(|b| !b.is_fixed());
+        self.sets.refresh(&self.bodies);
+        let (some_asleep, some_awake) = self.sets.some_asleep_and_awake();
         if some_asleep && some_awake {
             let reach = |b: &Body| {
                 (b.velocity.norm()
@@ -49,14 +50,14 @@ impl World {
                     * dt
             };
             let s = &mut self.scratch;
-            s.boxes.clear();
-            s.reach.clear();
+            s.wake_boxes.clear();
+            s.wake_reach.clear();
             for body in &self.bodies {
                 let r = body
                     .as_ref()
                     .map_or(0.0, |b| if b.asleep { 0.0 } else { reach(b) });
-                s.reach.push(r);
-                s.boxes
+                s.wake_reach.push(r);
+                s.wake_boxes
                     .push(body.as_ref().filter(|b| !b.is_static()).map(|b| {
                         let half = b.bounding_radius() + r + 0.5 * margin;
                         Aabb {
@@ -68,7 +69,7 @@ impl World {
             let bodies = &self.bodies;
             let asleep = |i: usize| bodies[i].as_ref().is_some_and(|b| b.asleep);
             s.wake_broad_phase
-                .pairs(&s.boxes, |i, j| asleep(i) != asleep(j), &mut s.pairs);
+                .pairs(&s.wake_boxes, |i, j| asleep(i) != asleep(j), &mut s.pairs);
             for &(i, j) in &s.pairs {
                 let (sleeper, awake) = if asleep(i as usize) { (i, j) } else { (j, i) };
                 let (b, a) = (
@@ -77,7 +78,7 @@ impl World {
                 );
                 let apart =
                     (b.position - a.position).norm() - b.bounding_radius() - a.bounding_radius();
-                if apart <= margin + s.reach[awake as usize] {
+                if apart <= margin + s.wake_reach[awake as usize] {
                     wake.push(self.sleep_labels[sleeper as usize]);
                 }
             }
@@ -175,6 +176,7 @@ impl World {
             {
                 b.fall_asleep();
                 self.sleep_labels[i as usize] = root;
+                self.sets.mark_changed();
             }
         }
         self.scratch.island_ready = ready;

@@ -1,0 +1,73 @@
+//! The world's bodies sorted by what a step does with them: static bodies never move,
+//! sleeping ones stay where they are until woken, and awake ones are the only ones a
+//! step moves. The sets are slots into `World::bodies`, in ascending order, so that a
+//! stage walking the awake set visits its bodies in the order a walk over every slot
+//! would, and the numbers come out the same.
+//!
+//! A stage that keeps per-body results (outlines, bounds, reaches) refreshes the awake
+//! ones every step and the rest only when the `epoch` it saw has passed: when a body was
+//! added or removed, fell asleep or woke, or was handed out by `World::body_mut` while
+//! static or asleep (and so may have been moved by hand).
+
+use crate::body::Body;
+
+#[derive(Debug, Clone, Default)]
+pub(super) struct BodySets {
+    statics: Vec<u32>,
+    sleeping: Vec<u32>,
+    awake: Vec<u32>,
+    /// Counts the changes outside the awake set; starts at 1 once a body is added, so that
+    /// a stage that has seen nothing (0) refreshes everything.
+    epoch: u64,
+    /// The lists are to be sorted again from the bodies before they are next read.
+    stale: bool,
+}
+
+impl BodySets {
+    /// A body outside the awake set may have changed, or a body changed sets.
+    pub(super) fn mark_changed(&mut self) {
+        self.epoch += 1;
+        self.stale = true;
+    }
+
+    pub(super) fn epoch(&self) -> u64 {
+        self.epoch
+    }
+
+    /// Sorts the bodies into the sets again if anything changed since the last time.
+    pub(super) fn refresh(&mut self, bodies: &[Option<Body>]) {
+        if !std::mem::take(&mut self.stale) {
+            return;
+        }
+        self.statics.clear();
+        self.sleeping.clear();
+        self.awake.clear();
+        for (i, body) in bodies.iter().enumerate() {
+            let Some(body) = body else {
+                continue;
+            };
+            let set = if body.is_static() {
+                &mut self.statics
+            } else if body.is_asleep() {
+                &mut self.sleeping
+            } else {
+                &mut self.awake
+            };
+            set.push(i as u32);
+        }
+    }
+
+    /// The bodies a step moves (bodies `auto` holds for one of its passes among them).
+    /// Current only after `refresh`.
+    pub(super) fn awake(&self) -> &[u32] {
+        debug_assert!(!self.stale, "read before refresh");
+        &self.awake
+    }
+
+    /// Whether some body is asleep, and whether some body is awake (current after
+    /// `refresh`).
+    pub(super) fn some_asleep_and_awake(&self) -> (bool, bool) {
+        debug_assert!(!self.stale, "read before refresh");
+        (!self.sleeping.is_empty(), !self.awake.is_empty())
+    }
+}
