@@ -426,4 +426,111 @@ mod tests {
             "bare bounds paired {bare} times, grown {grown}, pairs kept {kept} times"
         );
     }
+
+    /// The candidates from bounds made afresh from every body where it is now, whatever
+    /// the step kept: pairs of bodies whose outlines' bounds, each grown by half the
+    /// contact margin and its reach in `dt`, overlap (pairs of two fixed bodies aside).
+    fn pairs_from_fresh_bounds(world: &World, dt: f64) -> Vec<(u32, u32)> {
+        let margin = world.settings.contact_margin();
+        let bounds: Vec<Option<Aabb>> = world
+            .bodies
+            .iter()
+            .map(|b| {
+                let b = b.as_ref()?;
+                let spin = b.angular_velocity.abs() * b.bounding_radius();
+                let reach = (b.velocity.norm() + spin) * dt;
+                let mut corners = b.world_vertices();
+                let first = corners.next()?;
+                let mut aabb = Aabb {
+                    min: first,
+                    max: first,
+                };
+                for v in corners {
+                    aabb.min = aabb.min.inf(&v);
+                    aabb.max = aabb.max.sup(&v);
+                }
+                Some(aabb.grown(0.5 * margin + reach))
+            })
+            .collect();
+        let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
+        let n = bounds.len();
+        (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .filter(|&(i, j)| !(fixed(i) && fixed(j)))
+            .filter(|&(i, j)| match (&bounds[i], &bounds[j]) {
+                (Some(a), Some(b)) => a.overlaps(b),
+                _ => false,
+            })
+            .map(|(i, j)| (i as u32, j as u32))
+            .collect()
+    }
+
+    /// The step looks again only at the awake bodies; the others' bounds are kept until
+    /// the sets change. Boxes fall on a row of static tiles, fall asleep and are woken.
+    /// Beside one of them, a static slab is given a velocity by hand (a conveyor: it
+    /// stays, and its reach grows its bounds to the box) and stopped again; then a tile
+    /// is pulled from under the box by hand. At every step the candidates are the pairs
+    /// of bounds made afresh from every body.
+    #[test]
+    fn candidates_follow_bodies_that_only_sometimes_move() {
+        for solver in [
+            ContactSolver::Soft,
+            ContactSolver::Auto,
+            ContactSolver::Exact,
+        ] {
+            let mut world = World::new(Vec2::new(0.0, 10.0));
+            world.settings.contact_solver = solver;
+            world.settings.sleeping = true;
+            let tile = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+            let tiles: Vec<_> = (0..40)
+                .map(|i| {
+                    let def = BodyDef::new(tile.clone(), 0.0).at(Vec2::new(i as f64, 0.0), 0.0);
+                    world.add_body(def).unwrap()
+                })
+                .collect();
+            for i in 0..6 {
+                let at = Vec2::new(2.0 + 3.0 * i as f64, -1.5);
+                world
+                    .add_body(BodyDef::new(tile.clone(), 1.0).at(at, 0.1))
+                    .unwrap();
+            }
+            // At rest on tiles 31 and 32, 0.1 right of the conveyor's end.
+            let at = Vec2::new(31.6, -1.0);
+            let by_conveyor = world.add_body(BodyDef::new(tile.clone(), 1.0).at(at, 0.0));
+            let by_conveyor = by_conveyor.unwrap();
+            let slab = ConvexPolygon::rectangle(2.0, 0.2).unwrap();
+            let conveyor = BodyDef::new(slab, 0.0).at(Vec2::new(30.0, -1.0), 0.0);
+            let conveyor = world.add_body(conveyor).unwrap();
+            let dt = 1.0 / 60.0;
+            let mut asleep_seen = false;
+            let pair_with_conveyor = |world: &World| {
+                let pair = (by_conveyor.0.min(conveyor.0), by_conveyor.0.max(conveyor.0));
+                world.scratch.pairs.contains(&pair)
+            };
+            for step in 0..180 {
+                match step {
+                    100 => world.wake_body(by_conveyor),
+                    // 30 m/s away from the box: half a box in a step, over the 0.1 gap.
+                    110 => world.body_mut(conveyor).unwrap().velocity = Vec2::new(-30.0, 0.0),
+                    115 => world.body_mut(conveyor).unwrap().velocity = Vec2::zeros(),
+                    120 => world.body_mut(tiles[32]).unwrap().position.y += 2.0,
+                    _ => {}
+                }
+                world.step(dt);
+                asleep_seen |= world.body(by_conveyor).unwrap().is_asleep();
+                world.find_candidate_pairs(dt);
+                let fresh = pairs_from_fresh_bounds(&world, dt);
+                assert_eq!(world.scratch.pairs, fresh, "{solver:?}, step {step}");
+                if step < 120 {
+                    let conveyor_on = (110..115).contains(&step);
+                    assert_eq!(
+                        pair_with_conveyor(&world),
+                        conveyor_on,
+                        "{solver:?}, {step}"
+                    );
+                }
+            }
+            assert!(asleep_seen, "{solver:?}: the boxes fell asleep");
+        }
+    }
 }

@@ -620,6 +620,8 @@ impl World {
         if self.settings.sleeping {
             self.wake_where_needed(dt);
         }
+        // Sorted before `auto` holds any body for a pass: the sets are the world's own.
+        self.sets.refresh(&self.bodies);
         if self.settings.continuous {
             let start = &mut self.scratch.step_start;
             start.clear();
