@@ -71,3 +71,17 @@ impl BodySets {
         (!self.sleeping.is_empty(), !self.awake.is_empty())
     }
 }
+
+/// The sets' epoch that a stage's kept per-body results were made at (none yet: made
+/// at none).
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct EpochSeen(Option<u64>);
+
+impl EpochSeen {
+    /// Whether the sets changed since the last call (or since ever): then every body's
+    /// result is to be made again, and not only the awake ones'.
+    pub(super) fn sets_changed(&mut self, sets: &BodySets) -> bool {
+        let now = Some(sets.epoch);
+        std::mem::replace(&mut self.0, now) != now
+    }
+}

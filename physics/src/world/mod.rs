@@ -17,7 +17,7 @@ pub(crate) mod stats;
 use settings::{Integrator, StepSettings};
 
 use auto::{AutoMemory, IslandNeeds};
-use body_sets::BodySets;
+use body_sets::{BodySets, EpochSeen};
 use candidates::{KeptPairs, NeighbourScratch};
 use solver_bodies::GapTargets;
 use stats::StepStats;
@@ -254,6 +254,8 @@ struct Scratch {
     /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
     fixed_now: Vec<bool>,
     solver_bodies: Vec<SolverBody>,
+    /// When the static and sleeping bodies of `solver_bodies` were copied.
+    solver_bodies_seen: EpochSeen,
     /// How far each body can move this step, and the two parts of it: its centroid's
     /// displacement at its current velocity, and how far its spin can carry its
     /// farthest point.
@@ -269,6 +271,8 @@ struct Scratch {
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
     joint_constraints: Vec<JointConstraint>,
     accelerations: Vec<(Vec2, f64)>,
+    /// When `accelerations` of static and sleeping bodies were set.
+    accelerations_seen: EpochSeen,
     /// Every body's centroid and angle when the step began, for continuous collision.
     step_start: Vec<(Vec2, f64)>,
     /// Continuous collision: the moving body's outline where its step ends and starts,
@@ -700,15 +704,21 @@ impl World {
         // The soft step pulls every pin closed its own way: no repair targets.
         self.gather_solver_bodies_with(GapTargets::None);
         let s = &mut self.scratch;
-        s.accelerations.clear();
-        s.accelerations.extend(self.bodies.iter().map(|b| match b {
-            Some(b) if !b.is_fixed() => (
-                self.gravity + b.force * b.inv_mass,
-                b.torque * b.inv_inertia,
-            ),
-            _ => (Vec2::zeros(), 0.0),
-        }));
-        s.accelerations.push((Vec2::zeros(), 0.0));
+        // Zero but for the bodies the step moves (the ground's, last, among the zeros).
+        let changed = s.accelerations_seen.sets_changed(&self.sets);
+        if changed || s.accelerations.len() != self.bodies.len() + 1 {
+            s.accelerations.clear();
+            s.accelerations
+                .resize(self.bodies.len() + 1, (Vec2::zeros(), 0.0));
+        }
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_ref().expect("an awake body");
+            s.accelerations[i as usize] = if b.is_fixed() {
+                (Vec2::zeros(), 0.0) // held by `auto` for this pass
+            } else {
+                (self.gravity + b.force * b.inv_mass, b.torque * b.inv_inertia)
+            };
+        }
         // The impact pass runs only where two moving bodies may bounce (a pile of cor 0
         // pays one look at its contacts). Two that meet within the step sooner than their
         // velocities at its start foretold (a pendulum speeding up through its pin) would

@@ -25,14 +25,24 @@ impl World {
 
     pub(super) fn gather_solver_bodies_with(&mut self, targets: GapTargets) {
         let s = &mut self.scratch;
-        s.solver_bodies.clear();
-        s.solver_bodies.extend(
-            self.bodies
-                .iter()
-                .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
-        );
         let ground = self.bodies.len() as u32;
-        s.solver_bodies.push(SolverBody::default());
+        // Static and sleeping bodies are copied when the sets change; the solvers move
+        // neither, so their copies stay as made.
+        let changed = s.solver_bodies_seen.sets_changed(&self.sets);
+        if changed || s.solver_bodies.len() != self.bodies.len() + 1 {
+            s.solver_bodies.clear();
+            s.solver_bodies.extend(
+                self.bodies
+                    .iter()
+                    .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
+            );
+            s.solver_bodies.push(SolverBody::default());
+        } else {
+            for &i in self.sets.awake() {
+                let body = self.bodies[i as usize].as_ref().expect("an awake body");
+                s.solver_bodies[i as usize] = SolverBody::from_body(body);
+            }
+        }
         s.joint_constraints.clear();
         for (i, j) in self.joints.iter().enumerate() {
             let Some(j) = j else { continue };
@@ -58,15 +68,16 @@ impl World {
         }
     }
 
-    /// Copies solved velocities (and motor impulses) back.
+    /// Copies solved velocities and poses (of the bodies the step moves) and motor
+    /// impulses back.
     pub(super) fn scatter_solver_bodies(&mut self) {
-        for (body, solved) in self.bodies.iter_mut().zip(&self.scratch.solver_bodies) {
-            if let Some(b) = body {
-                b.velocity = solved.velocity;
-                b.angular_velocity = solved.angular_velocity;
-                b.position = solved.position;
-                b.angle = solved.angle;
-            }
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_mut().expect("an awake body");
+            let solved = &self.scratch.solver_bodies[i as usize];
+            b.velocity = solved.velocity;
+            b.angular_velocity = solved.angular_velocity;
+            b.position = solved.position;
+            b.angle = solved.angle;
         }
         for c in &self.scratch.joint_constraints {
             if let Some(Some(j)) = self.joints.get_mut(c.joint as usize) {
