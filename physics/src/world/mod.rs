@@ -222,6 +222,8 @@ struct Solvers {
     /// The islands' LCPs of `thesis` and `exact`, and the impact pass of every solver.
     exact: SimultaneousSolver,
     soft: SoftStepSolver,
+    /// When the soft solver last loaded the static and sleeping bodies.
+    soft_seen: EpochSeen,
 }
 
 /// Buffers reused from step to step so that stepping does not allocate.
@@ -716,7 +718,10 @@ impl World {
             s.accelerations[i as usize] = if b.is_fixed() {
                 (Vec2::zeros(), 0.0) // held by `auto` for this pass
             } else {
-                (self.gravity + b.force * b.inv_mass, b.torque * b.inv_inertia)
+                (
+                    self.gravity + b.force * b.inv_mass,
+                    b.torque * b.inv_inertia,
+                )
             };
         }
         // The impact pass runs only where two moving bodies may bounce (a pile of cor 0
@@ -738,6 +743,9 @@ impl World {
                 self.propagate_impacts_before_soft_step(dt, &unforeseen);
             }
             let s = &mut self.scratch;
+            if !self.solvers.soft_seen.sets_changed(&self.sets) {
+                self.solvers.soft.bodies_changed_only(self.sets.awake());
+            }
             self.solvers.soft.step(
                 &SoftSettings {
                     substeps: self.settings.soft_substeps.max(1),

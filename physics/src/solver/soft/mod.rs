@@ -201,6 +201,17 @@ impl SoftBody {
         }
     }
 
+    /// A body as the step starts it: its velocity and inverse mass, not yet moved.
+    fn at_step_start(b: &SolverBody) -> Self {
+        Self {
+            v: b.velocity,
+            w: b.angular_velocity,
+            inv_mass: b.inv_mass,
+            inv_inertia: b.inv_inertia,
+            ..Self::null()
+        }
+    }
+
     /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
     fn moves(&self) -> bool {
         self.inv_mass > 0.0 || self.inv_inertia > 0.0
@@ -381,6 +392,17 @@ pub(crate) struct SoftStepSolver {
     /// The bodies that move or have a velocity, increasing: the only ones the substeps
     /// integrate (a terrain of 2,000 static tiles is not walked four times a step).
     in_motion: Vec<u32>,
+    /// The bodies that move, increasing: the ones `store` writes back.
+    moving: Vec<u32>,
+    /// The fixed bodies with a velocity (a conveyor), increasing: loaded again every
+    /// step, as their motion within a step is the solver's own.
+    fixed_in_motion: Vec<u32>,
+    /// The slots, increasing, whose bodies alone may differ from those the last step was
+    /// handed (`bodies_changed_only`), for the next step; unless set, every body.
+    changed_only: Vec<u32>,
+    only_those_changed: bool,
+    /// Scratch for `load_bodies`: last step's fixed bodies in motion.
+    spare_slots: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
     contact_islands: Vec<(usize, usize)>,
     /// `joints` index ranges, one per island of pins, and the buffers of their solve.
@@ -470,6 +492,16 @@ fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool
 }
 
 impl SoftStepSolver {
+    /// For the next step only: of the bodies it is handed, only those in `slots`
+    /// (increasing) may differ from those the last step was handed, and every body that
+    /// moves is among them; the rest are fixed, and at rest or as they were. The step
+    /// then loads only those, and the fixed bodies with a velocity.
+    pub(crate) fn bodies_changed_only(&mut self, slots: &[u32]) {
+        self.changed_only.clear();
+        self.changed_only.extend_from_slice(slots);
+        self.only_those_changed = true;
+    }
+
     /// How many times the pin islands' matrices were factored (`StepStats`).
     pub(crate) fn pin_factorisations(&self) -> u64 {
         self.block.factored
@@ -703,6 +735,55 @@ mod tests {
         let around = first.plan_inputs.iter().map(|p| p.first_and_count());
         let around: Vec<_> = around.filter(|&(k, _)| (22..28).contains(&k)).collect();
         assert_eq!(around, [(22, 2), (24, 1), (25, 1), (26, 2)]);
+    }
+
+    /// A step told which bodies changed (`bodies_changed_only`) loads only those and the
+    /// fixed bodies with a velocity, and must move every body exactly as a step that loads
+    /// every one: three columns on a floor, through steps where only the boxes change,
+    /// then with the floor given a velocity up and along (every body loaded that step,
+    /// and after it the floor again every step, as a fixed body in motion).
+    #[test]
+    fn a_step_loading_only_the_changed_bodies_moves_them_as_one_loading_all() {
+        let (bodies, contacts) = columns(&[5, 3, 1]);
+        let floor = bodies.len() - 1;
+        let boxes: Vec<u32> = (0..floor as u32).collect();
+        let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
+        let settings = SoftSettings::for_length_scale(1.0);
+        let (mut all, mut some) = (SoftStepSolver::default(), SoftStepSolver::default());
+        let (mut bodies_all, mut bodies_some) = (bodies.clone(), bodies);
+        let mut steps_loading_some = 0;
+        for k in 0..16 {
+            if k == 8 {
+                bodies_all[floor].velocity = Vec2::new(0.3, -0.1);
+                bodies_some[floor].velocity = Vec2::new(0.3, -0.1);
+            } else if k > 0 {
+                some.bodies_changed_only(&boxes);
+                steps_loading_some += 1;
+            }
+            let step = |solver: &mut SoftStepSolver, bodies: &mut [SolverBody]| {
+                let mut contacts = contacts.clone();
+                let a = &accelerations;
+                solver.step(
+                    &settings,
+                    bodies,
+                    a,
+                    &mut contacts,
+                    &mut [],
+                    1.0 / 60.0,
+                    1.0,
+                );
+                contacts
+            };
+            let contacts_all = step(&mut all, &mut bodies_all);
+            let contacts_some = step(&mut some, &mut bodies_some);
+            assert_eq!(
+                state_bits(&bodies_all, &contacts_all),
+                state_bits(&bodies_some, &contacts_some),
+                "step {k}"
+            );
+            assert_eq!(some.a_fixed_body_moves, k >= 8, "step {k}");
+        }
+        assert_eq!(steps_loading_some, 14);
     }
 
     /// Coloured islands solved in chunks, each through every substep before the next

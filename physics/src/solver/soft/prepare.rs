@@ -31,32 +31,41 @@ impl SoftStepSolver {
     }
 
     /// The bodies as the soft step reads them, the null body last, and which bodies a pin
-    /// joins.
+    /// joins: every body, or where the caller said which changed (`bodies_changed_only`)
+    /// those and the fixed bodies with a velocity.
     fn load_bodies(&mut self, bodies: &[SolverBody], joints: &[JointConstraint]) {
-        self.bodies.clear();
+        let only_some =
+            std::mem::take(&mut self.only_those_changed) && self.bodies.len() == bodies.len() + 1;
         self.in_motion.clear();
-        let mut a_fixed_body_moves = false;
-        self.bodies.extend(bodies.iter().enumerate().map(|(i, b)| {
-            let body = SoftBody {
-                v: b.velocity,
-                w: b.angular_velocity,
-                inv_mass: b.inv_mass,
-                inv_inertia: b.inv_inertia,
-                dp: Vec2::zeros(),
-                dq: Rot { cos: 1.0, sin: 0.0 },
-                dangle: 0.0,
-            };
-            let has_velocity = body.v != Vec2::zeros() || body.w != 0.0;
-            a_fixed_body_moves |= !body.moves() && has_velocity;
-            if body.moves() || has_velocity {
-                self.in_motion.push(i as u32);
+        self.moving.clear();
+        let mut fixed_in_motion = std::mem::take(&mut self.fixed_in_motion);
+        if only_some {
+            let changed = std::mem::take(&mut self.changed_only);
+            let mut was_in_motion = std::mem::take(&mut self.spare_slots);
+            was_in_motion.clone_from(&fixed_in_motion);
+            fixed_in_motion.clear();
+            for i in merged_increasing(&changed, &was_in_motion) {
+                self.bodies[i as usize] = SoftBody::at_step_start(&bodies[i as usize]);
+                self.note_motion(i, &mut fixed_in_motion);
             }
-            body
-        }));
-        self.a_fixed_body_moves = a_fixed_body_moves;
-        // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
-        // and at rest, and past the bodies `store` writes back.
-        self.bodies.push(SoftBody::null());
+            self.changed_only = changed;
+            self.spare_slots = was_in_motion;
+            // The null body, last: where a batch's unused lanes point (`batch::PAD`).
+            *self.bodies.last_mut().expect("the null body") = SoftBody::null();
+        } else {
+            fixed_in_motion.clear();
+            self.bodies.clear();
+            self.bodies
+                .extend(bodies.iter().map(SoftBody::at_step_start));
+            for i in 0..bodies.len() as u32 {
+                self.note_motion(i, &mut fixed_in_motion);
+            }
+            // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
+            // and at rest, and past the bodies `store` writes back.
+            self.bodies.push(SoftBody::null());
+        }
+        self.a_fixed_body_moves = !fixed_in_motion.is_empty();
+        self.fixed_in_motion = fixed_in_motion;
         self.pinned.clear();
         if !joints.is_empty() {
             self.pinned.resize(bodies.len(), false);
@@ -64,6 +73,21 @@ impl SoftStepSolver {
                 self.pinned[j.body_a as usize] = true;
                 self.pinned[j.body_b as usize] = true;
             }
+        }
+    }
+
+    /// Lists body `i`, just loaded, among those that move, those in motion and the fixed
+    /// ones in motion, as it is.
+    fn note_motion(&mut self, i: u32, fixed_in_motion: &mut Vec<u32>) {
+        let body = &self.bodies[i as usize];
+        let has_velocity = body.v != Vec2::zeros() || body.w != 0.0;
+        if body.moves() {
+            self.moving.push(i);
+        } else if has_velocity {
+            fixed_in_motion.push(i);
+        }
+        if body.moves() || has_velocity {
+            self.in_motion.push(i);
         }
     }
 
@@ -286,4 +310,22 @@ pub(super) fn island_ranges(grouped: &[(u32, u32)], ranges: &mut Vec<(usize, usi
         ranges.push((start, start + len));
         start += len;
     }
+}
+
+/// The slots of two increasing lists, increasing, each once.
+fn merged_increasing<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = u32> + 'a {
+    let (mut a, mut b) = (a.iter().copied().peekable(), b.iter().copied().peekable());
+    std::iter::from_fn(move || match (a.peek(), b.peek()) {
+        (Some(&x), Some(&y)) => {
+            if x <= y {
+                a.next();
+            }
+            if y <= x {
+                b.next();
+            }
+            Some(x.min(y))
+        }
+        (Some(_), None) => a.next(),
+        (None, _) => b.next(),
+    })
 }

@@ -51,10 +51,8 @@ impl SoftStepSolver {
         contacts: &mut [Contact],
         joints: &mut [JointConstraint],
     ) {
-        for (b, s) in bodies.iter_mut().zip(&self.bodies) {
-            if !s.moves() {
-                continue;
-            }
+        for &i in &self.moving {
+            let (b, s) = (&mut bodies[i as usize], &self.bodies[i as usize]);
             b.velocity = s.v;
             b.angular_velocity = s.w;
             b.position += s.dp;
