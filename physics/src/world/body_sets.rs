@@ -64,6 +64,12 @@ impl BodySets {
         &self.awake
     }
 
+    /// The static bodies (current after `refresh`).
+    pub(super) fn statics(&self) -> &[u32] {
+        debug_assert!(!self.stale, "read before refresh");
+        &self.statics
+    }
+
     /// Whether some body is asleep, and whether some body is awake (current after
     /// `refresh`).
     pub(super) fn some_asleep_and_awake(&self) -> (bool, bool) {

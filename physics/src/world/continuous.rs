@@ -11,18 +11,14 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
-        // The static bodies' slots, outlines and bounds, built once per step when the
-        // first body needs them (most steps, none does).
+        // The static bodies' slots, outlines and bounds, looked at when the first body
+        // needs them (most steps, none does), and built again only if the sets changed.
         let mut obstacles = std::mem::take(&mut s.obstacles);
         let mut count: Option<usize> = None;
         s.impacts.clear();
-        for i in 0..self.bodies.len() {
-            let Some(body) = self.bodies[i].as_ref() else {
-                continue;
-            };
-            if body.is_fixed() {
-                continue;
-            }
+        for &i in self.sets.awake() {
+            let i = i as usize;
+            let body = self.bodies[i].as_ref().expect("an awake body");
             let sweep = Sweep {
                 start: s.step_start[i],
                 end: (body.position, body.angle),
@@ -46,11 +42,12 @@ impl World {
                 continue;
             }
             let count = *count.get_or_insert_with(|| {
+                if !s.obstacles_seen.sets_changed(&self.sets) {
+                    return obstacles.len();
+                }
                 let mut n = 0;
-                for (slot, obstacle) in self.bodies.iter().enumerate() {
-                    let Some(obstacle) = obstacle.as_ref().filter(|o| o.is_static()) else {
-                        continue;
-                    };
+                for &slot in self.sets.statics() {
+                    let obstacle = self.bodies[slot as usize].as_ref().expect("a static body");
                     if obstacles.len() == n {
                         obstacles.push(Default::default());
                     }
@@ -58,14 +55,15 @@ impl World {
                     // The same static body where it was placed last time has the same
                     // outline: a terrain of many is not turned again at every fast body.
                     let place = obstacle.place();
-                    if *index != slot as u32 || *placed_at != place || polygon.vertices.is_empty() {
-                        *index = slot as u32;
+                    if *index != slot || *placed_at != place || polygon.vertices.is_empty() {
+                        *index = slot;
                         polygon.update(obstacle);
                         *bounds = polygon.aabb();
                         *placed_at = place;
                     }
                     n += 1;
                 }
+                obstacles.truncate(n);
                 n
             });
             let swept = Aabb {

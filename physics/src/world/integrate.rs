@@ -2,6 +2,7 @@
 //! from velocities, and forces cleared after the step.
 
 use super::{Integrator, World};
+use crate::body::Body;
 use crate::math::Vec2;
 
 impl World {
@@ -55,10 +56,19 @@ impl World {
         }
     }
 
+    /// Every force and torque back to zero: the awake bodies', and everyone's when the
+    /// sets changed (a force given by hand to a static or sleeping body goes too).
     pub(super) fn clear_forces(&mut self) {
-        for b in self.bodies.iter_mut().flatten() {
+        let clear = |b: &mut Body| {
             b.force = Vec2::zeros();
             b.torque = 0.0;
+        };
+        if self.scratch.forces_seen.sets_changed(&self.sets) {
+            self.bodies.iter_mut().flatten().for_each(clear);
+        } else {
+            for &i in self.sets.awake() {
+                clear(self.bodies[i as usize].as_mut().expect("an awake body"));
+            }
         }
     }
 }

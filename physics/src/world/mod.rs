@@ -275,7 +275,8 @@ struct Scratch {
     accelerations: Vec<(Vec2, f64)>,
     /// When `accelerations` of static and sleeping bodies were set.
     accelerations_seen: EpochSeen,
-    /// Every body's centroid and angle when the step began, for continuous collision.
+    /// By slot, each awake body's centroid and angle when the step began, for continuous
+    /// collision.
     step_start: Vec<(Vec2, f64)>,
     /// Continuous collision: the moving body's outline where its step ends and starts,
     /// and the time-of-impact search's own.
@@ -285,6 +286,9 @@ struct Scratch {
     /// Continuous collision: static bodies' slots, outlines and bounds; the bodies
     /// stopped and their times of impact; joint islands and each island's earliest impact.
     obstacles: Vec<(u32, WorldPolygon, Aabb, [u64; 3])>,
+    obstacles_seen: EpochSeen,
+    /// When every body's forces were last cleared (`clear_forces`).
+    forces_seen: EpochSeen,
     impacts: Vec<(u32, f64)>,
     impact_union: UnionFind,
     island_impact: Vec<f64>,
@@ -599,10 +603,8 @@ impl World {
     /// Every moving body's state finite and within `crate::limits`.
     fn check_state(&self) -> Result<(), StepError> {
         use crate::limits::{COORDINATE, SPEED, SPIN};
-        for (i, body) in self.bodies.iter().enumerate() {
-            let Some(b) = body.as_ref().filter(|b| !b.is_fixed()) else {
-                continue;
-            };
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_ref().expect("an awake body");
             let numbers = [
                 ("x", b.position.x, COORDINATE),
                 ("y", b.position.y, COORDINATE),
@@ -611,7 +613,7 @@ impl World {
             ];
             if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
                 return Err(StepError::StateBeyond {
-                    body: i as u32,
+                    body: i,
                     what,
                     value,
                     limit,
@@ -629,12 +631,13 @@ impl World {
         // Sorted before `auto` holds any body for a pass: the sets are the world's own.
         self.sets.refresh(&self.bodies);
         if self.settings.continuous {
+            // Read for the awake bodies only.
             let start = &mut self.scratch.step_start;
-            start.clear();
-            start.extend(self.bodies.iter().map(|b| {
-                b.as_ref()
-                    .map_or((Vec2::zeros(), 0.0), |b| (b.position, b.angle))
-            }));
+            start.resize(self.bodies.len(), (Vec2::zeros(), 0.0));
+            for &i in self.sets.awake() {
+                let b = self.bodies[i as usize].as_ref().expect("an awake body");
+                start[i as usize] = (b.position, b.angle);
+            }
         }
         self.apply_motor_torques(dt);
         match self.settings.contact_solver.stage_list() {
@@ -657,6 +660,7 @@ impl World {
             self.sleep_labels.clear();
             self.sets.mark_changed();
         }
+        self.sets.refresh(&self.bodies);
     }
 
     fn step_impulses(&mut self, method: ImpulseMethod, dt: f64) {
