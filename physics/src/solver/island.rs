@@ -86,11 +86,16 @@ pub(crate) fn group_by_island(
 
 /// `group_by_island` with its last result kept: a pile at rest has the same contacts,
 /// between the same bodies, step after step, and then the islands are those it found.
+/// The bodies that connect are given as a list of their slots, increasing: a terrain of
+/// 2,000 static tiles under a few boxes compares the few, not 2,000 flags.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct IslandGrouping {
     uf: UnionFind,
-    /// The last call's item ends and which bodies connected.
+    /// The last call's item ends, body count and connecting bodies.
     ends: Vec<(u32, u32)>,
+    bodies: usize,
+    dynamic_slots: Vec<u32>,
+    /// `dynamic_slots` by slot, made when the grouping is found again.
     dynamic: Vec<bool>,
     grouped: Vec<(u32, u32)>,
     /// Whether the last call kept the grouping before it.
@@ -104,23 +109,30 @@ impl IslandGrouping {
         self.kept
     }
 
-    /// `group_by_island`'s result for these items, found again only if an item's ends or
-    /// a body's `dynamic` differ from the last call's.
+    /// `group_by_island`'s result for these items, with the bodies `dynamic_slots`
+    /// (increasing) connecting, found again only if an item's ends or the connecting
+    /// bodies differ from the last call's.
     pub(crate) fn group(
         &mut self,
         count: usize,
         bodies: usize,
         ends: impl Fn(usize) -> (u32, u32),
-        dynamic: impl Fn(u32) -> bool,
+        dynamic_slots: &[u32],
     ) -> &[(u32, u32)] {
         // Items first: a step that changes anything usually changes them early.
         let same = self.ends.len() == count
             && (0..count).all(|i| self.ends[i] == ends(i))
-            && self.dynamic_unchanged(bodies, &dynamic);
+            && self.dynamic_unchanged(bodies, dynamic_slots);
         self.kept = same;
         if !same {
+            self.bodies = bodies;
+            self.dynamic_slots.clear();
+            self.dynamic_slots.extend_from_slice(dynamic_slots);
             self.dynamic.clear();
-            self.dynamic.extend((0..bodies as u32).map(&dynamic));
+            self.dynamic.resize(bodies, false);
+            for &slot in dynamic_slots {
+                self.dynamic[slot as usize] = true;
+            }
             self.ends.clear();
             self.ends.extend((0..count).map(&ends));
             // From the copies just taken, not the callers' (larger) items again.
@@ -137,26 +149,26 @@ impl IslandGrouping {
         &self.grouped
     }
 
-    /// Whether there are `count` items again and every body's `dynamic` is as at the last
-    /// call: then the last call's grouping (`grouped`) stands if every item's ends are as
-    /// they were (`ends`), which this leaves unchecked. A caller that takes it must compare
-    /// every item's ends with those before it relies on the grouping, and call `group` if
-    /// any differs; `kept` says true until then. (Checking them here would read every item
-    /// once more: the big piles' contacts are 3 MB, and their points read each one anyway.)
+    /// Whether there are `count` items again and the same bodies connect: then the last
+    /// call's grouping (`grouped`) stands if every item's ends are as they were (`ends`),
+    /// which this leaves unchecked. A caller that takes it must compare every item's ends
+    /// with those before it relies on the grouping, and call `group` if any differs;
+    /// `kept` says true until then. (Checking them here would read every item once more:
+    /// the big piles' contacts are 3 MB, and their points read each one anyway.)
     pub(crate) fn bodies_kept(
         &mut self,
         count: usize,
         bodies: usize,
-        dynamic: impl Fn(u32) -> bool,
+        dynamic_slots: &[u32],
     ) -> bool {
-        let same = self.ends.len() == count && self.dynamic_unchanged(bodies, &dynamic);
+        let same = self.ends.len() == count && self.dynamic_unchanged(bodies, dynamic_slots);
         self.kept = same;
         same
     }
 
-    /// Whether there are `bodies` bodies again, each `dynamic` as at the last call.
-    fn dynamic_unchanged(&self, bodies: usize, dynamic: &impl Fn(u32) -> bool) -> bool {
-        self.dynamic.len() == bodies && (0..bodies).all(|i| self.dynamic[i] == dynamic(i as u32))
+    /// Whether there are `bodies` bodies again, the same ones connecting.
+    fn dynamic_unchanged(&self, bodies: usize, dynamic_slots: &[u32]) -> bool {
+        self.bodies == bodies && self.dynamic_slots == dynamic_slots
     }
 
     /// The last call's result: `(island key, item)` pairs, as `group` returned them.
@@ -168,6 +180,12 @@ impl IslandGrouping {
     pub(crate) fn ends(&self) -> &[(u32, u32)] {
         &self.ends
     }
+}
+
+/// The slots of `bodies` that `moves`, increasing, into `out`.
+pub(crate) fn slots_that_move<B>(bodies: &[B], moves: impl Fn(&B) -> bool, out: &mut Vec<u32>) {
+    out.clear();
+    out.extend((0..bodies.len() as u32).filter(|&i| moves(&bodies[i as usize])));
 }
 
 /// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
@@ -237,13 +255,14 @@ mod tests {
                 &mut uf,
                 &mut fresh,
             );
-            let bodies_kept = kept.bodies_kept(items.len(), 5, |s| s != fixed);
+            let dynamic: Vec<u32> = (0..5).filter(|&s| s != fixed).collect();
+            let bodies_kept = kept.bodies_kept(items.len(), 5, &dynamic);
             assert_eq!(bodies_kept, bodies_same, "{items:?}, body {fixed} fixed");
             if bodies_kept {
                 let ends_kept = (0..items.len()).all(|i| kept.ends()[i] == items[i]);
                 assert_eq!(ends_kept, same, "{items:?}, body {fixed} fixed");
             }
-            let got = kept.group(items.len(), 5, |i| items[i], |s| s != fixed);
+            let got = kept.group(items.len(), 5, |i| items[i], &dynamic);
             assert_eq!(got, &fresh[..], "{items:?}, body {fixed} fixed");
             assert_eq!(kept.kept(), same, "{items:?}, body {fixed} fixed");
         }

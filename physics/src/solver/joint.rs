@@ -1,7 +1,7 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
 use super::SolverBody;
-use super::island::IslandGrouping;
+use super::island::{IslandGrouping, slots_that_move};
 use super::pin_island::{PinIsland, displace_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
@@ -314,6 +314,8 @@ struct JointIslands {
     /// The joints' islands, kept while the joints and the moving bodies are the same (a
     /// chain's are found once, not at every pass of every substep).
     grouping: IslandGrouping,
+    /// The bodies that move, for the grouping.
+    moving: Vec<u32>,
     island: Vec<JointConstraint>,
 }
 
@@ -430,11 +432,12 @@ impl JointIslands {
         bodies: &mut [SolverBody],
         mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
     ) {
+        slots_that_move(bodies, SolverBody::moves, &mut self.moving);
         let grouped = self.grouping.group(
             joints.len(),
             bodies.len(),
             |i| (joints[i].body_a, joints[i].body_b),
-            |slot| bodies[slot as usize].moves(),
+            &self.moving,
         );
         let mut start = 0;
         while start < grouped.len() {

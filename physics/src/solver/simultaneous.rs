@@ -4,7 +4,7 @@
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
-use super::island::IslandGrouping;
+use super::island::{IslandGrouping, slots_that_move};
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
@@ -75,6 +75,8 @@ pub(crate) struct SimultaneousSolver {
     /// The contacts' and joints' islands, kept while the items and the moving bodies are
     /// the same (the passes of one substep find them once).
     grouping: IslandGrouping,
+    /// The bodies that move, for the grouping.
+    moving: Vec<u32>,
     /// Each island's span of `grouped`.
     ranges: Vec<(usize, usize)>,
     contact_count: usize,
@@ -346,7 +348,6 @@ impl SimultaneousSolver {
     ) {
         let nc = contacts.len();
         let joint_count = if with_joints { joints.len() } else { 0 };
-        let dynamic = |slot: u32| bodies[slot as usize].moves();
         let ends = |i: usize| {
             if i < nc {
                 (contacts[i].body_a.0, contacts[i].body_b.0)
@@ -354,9 +355,10 @@ impl SimultaneousSolver {
                 (joints[i - nc].body_a, joints[i - nc].body_b)
             }
         };
+        slots_that_move(bodies, SolverBody::moves, &mut self.moving);
         let grouped = self
             .grouping
-            .group(nc + joint_count, bodies.len(), ends, dynamic);
+            .group(nc + joint_count, bodies.len(), ends, &self.moving);
         self.contact_count = nc;
         self.ranges.clear();
         let mut start = 0;

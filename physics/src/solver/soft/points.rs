@@ -120,7 +120,7 @@ impl SoftStepSolver {
             contacts.len(),
             self.bodies.len() - 1, // not the null body
             |i| (contacts[i].body_a.0, contacts[i].body_b.0),
-            |i| self.bodies[i as usize].moves(),
+            &self.moving,
         );
         island_ranges(grouped, &mut self.contact_islands);
     }

@@ -105,9 +105,7 @@ impl SoftStepSolver {
         // its last grouping is taken unchecked, and the points, which read every contact,
         // check each one's bodies against it as they are built.
         let mut grouping = std::mem::take(&mut self.contact_grouping);
-        let reused = grouping.bodies_kept(contacts.len(), body_count, |i| {
-            self.bodies[i as usize].moves()
-        });
+        let reused = grouping.bodies_kept(contacts.len(), body_count, &self.moving);
         if !reused {
             self.group_contacts(&mut grouping, contacts);
         }
@@ -277,12 +275,12 @@ impl SoftStepSolver {
     /// Orders `joints` island by island (pins linked through moving bodies; each island
     /// keeps the joints' order) and records each island's range.
     fn group_joints(&mut self) {
-        let (joints, bodies) = (&self.joints, &self.bodies);
+        let joints = &self.joints;
         let grouped = self.joint_grouping.group(
             joints.len(),
-            bodies.len(),
+            self.bodies.len(),
             |i| (joints[i].a, joints[i].b),
-            |i| bodies[i as usize].moves(),
+            &self.moving,
         );
         // A net's pins are one island, in the joints' own order: nothing to move (copying
         // its 19,800 joints cost the joint grid 2% of its step).
