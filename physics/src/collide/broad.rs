@@ -41,12 +41,67 @@ pub(crate) struct BroadPhase {
     extents: Vec<f64>,
 }
 
+/// The cell holding coordinate `v` in a grid of `per_cell` cells per unit: floor(v ·
+/// per_cell) without a call to `floor` (the same for every finite value; NaN maps to 0
+/// and the infinities to the ends of i64).
+pub(super) fn cell_of(v: f64, per_cell: f64) -> i64 {
+    let t = v * per_cell;
+    let truncated = t as i64;
+    truncated - i64::from(t < truncated as f64)
+}
+
+/// The cells a box covers, `((x0, y0), (x1, y1))`, and whether it covers no more than
+/// `MAX_CELLS` (else it is compared with every body instead of being listed).
+pub(super) fn cells_of(b: &Aabb, per_cell: f64) -> (((i64, i64), (i64, i64)), bool) {
+    let (x0, x1) = (cell_of(b.min.x, per_cell), cell_of(b.max.x, per_cell));
+    let (y0, y1) = (cell_of(b.min.y, per_cell), cell_of(b.max.y, per_cell));
+    let span = |lo: i64, hi: i64| hi.saturating_sub(lo).saturating_add(1);
+    let covered = span(x0, x1).saturating_mul(span(y0, y1));
+    (((x0, y0), (x1, y1)), (1..=MAX_CELLS).contains(&covered))
+}
+
+/// Twice the median extent of the boxes of `slots` (1 when that is not a positive number:
+/// all of them points); `extents` is scratch.
+pub(super) fn cell_size(boxes: &[Option<Aabb>], slots: &[u32], extents: &mut Vec<f64>) -> f64 {
+    extents.clear();
+    extents.extend(slots.iter().filter_map(|&i| {
+        let b = boxes[i as usize]?;
+        Some((b.max.x - b.min.x).max(b.max.y - b.min.y))
+    }));
+    if extents.is_empty() {
+        return 1.0;
+    }
+    let middle = extents.len() / 2;
+    let (_, median, _) = extents.select_nth_unstable_by(middle, f64::total_cmp);
+    let cell = 2.0 * *median;
+    if cell.is_finite() && cell > 0.0 {
+        cell
+    } else {
+        1.0
+    }
+}
+
 impl BroadPhase {
     /// Candidate pairs `(i, j)`, `i < j`, whose boxes overlap, sorted, skipping pairs that
     /// `wanted` rejects. `boxes[i]` is `None` for bodies that take no part.
     pub(crate) fn pairs(
         &mut self,
         boxes: &[Option<Aabb>],
+        wanted: impl FnMut(usize, usize) -> bool,
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        let mut present = std::mem::take(&mut self.present);
+        present.clear();
+        present.extend((0..boxes.len() as u32).filter(|&i| boxes[i as usize].is_some()));
+        self.pairs_among(boxes, &present, wanted, out);
+        self.present = present;
+    }
+
+    /// `pairs` among the bodies of `slots` (increasing, each with a box) only.
+    pub(crate) fn pairs_among(
+        &mut self,
+        boxes: &[Option<Aabb>],
+        slots: &[u32],
         mut wanted: impl FnMut(usize, usize) -> bool,
         out: &mut Vec<(u32, u32)>,
     ) {
@@ -56,14 +111,11 @@ impl BroadPhase {
         self.large.clear();
         self.is_large.clear();
         self.is_large.resize(boxes.len(), false);
-        self.present.clear();
-        self.present
-            .extend((0..boxes.len() as u32).filter(|&i| boxes[i as usize].is_some()));
-        if self.present.len() <= ALL_PAIRS_LIMIT {
+        if slots.len() <= ALL_PAIRS_LIMIT {
             // A robot's few bodies: every pair, found in sorted order.
-            for (k, &i) in self.present.iter().enumerate() {
+            for (k, &i) in slots.iter().enumerate() {
                 let bi = boxes[i as usize].expect("present");
-                for &j in &self.present[k + 1..] {
+                for &j in &slots[k + 1..] {
                     let bj = boxes[j as usize].expect("present");
                     if bi.overlaps(&bj) && wanted(i as usize, j as usize) {
                         out.push((i, j));
@@ -72,36 +124,20 @@ impl BroadPhase {
             }
             return;
         }
-        let per_cell = 1.0 / self.cell_size(boxes);
+        let per_cell = 1.0 / cell_size(boxes, slots, &mut self.extents);
         self.lower_cells.clear();
         self.lower_cells.resize(boxes.len(), (0, 0));
-        // floor(t) without a call to `floor` (the same for every finite t, and both map
-        // NaN to 0 and the infinities to the ends of i64).
-        let index = |v: f64| {
-            let t = v * per_cell;
-            let truncated = t as i64;
-            truncated - i64::from(t < truncated as f64)
-        };
-        for (i, b) in boxes.iter().enumerate() {
-            let Some(b) = b else {
-                continue;
-            };
-            let (x0, x1, y0, y1) = (
-                index(b.min.x),
-                index(b.max.x),
-                index(b.min.y),
-                index(b.max.y),
-            );
-            let span = |lo: i64, hi: i64| hi.saturating_sub(lo).saturating_add(1);
-            let covered = span(x0, x1).saturating_mul(span(y0, y1));
-            if !(1..=MAX_CELLS).contains(&covered) {
-                self.large.push(i as u32);
-                self.is_large[i] = true;
+        for &i in slots {
+            let b = boxes[i as usize].expect("present");
+            let (((x0, y0), (x1, y1)), small) = cells_of(&b, per_cell);
+            if !small {
+                self.large.push(i);
+                self.is_large[i as usize] = true;
                 continue;
             }
-            self.lower_cells[i] = (x0, y0);
+            self.lower_cells[i as usize] = (x0, y0);
             for x in x0..=x1 {
-                self.entries.extend((y0..=y1).map(|y| ((x, y), i as u32)));
+                self.entries.extend((y0..=y1).map(|y| ((x, y), i)));
             }
         }
         self.group_by_cell();
@@ -141,13 +177,13 @@ impl BroadPhase {
         out.retain(|&(i, j)| wanted(i as usize, j as usize));
         for &l in &self.large {
             let bl = boxes[l as usize].expect("large bodies have bounds");
-            for (j, bj) in boxes.iter().enumerate() {
+            for &j in slots {
                 // Two large bodies are paired once, from the lower index.
-                let Some(bj) =
-                    bj.filter(|_| j != l as usize && !(self.is_large[j] && j < l as usize))
-                else {
+                let j = j as usize;
+                if j == l as usize || self.is_large[j] && j < l as usize {
                     continue;
-                };
+                }
+                let bj = boxes[j].expect("present");
                 let (lo, hi) = (j.min(l as usize), j.max(l as usize));
                 if bl.overlaps(&bj) && wanted(lo, hi) {
                     out.push((lo as u32, hi as u32));
@@ -159,7 +195,7 @@ impl BroadPhase {
 
     /// Sorts `out` by a radix sort on its two body indices (`< bodies`): linear, where a
     /// comparison sort was a quarter of the broad phase's time on a pile.
-    fn sort_pairs(&mut self, out: &mut Vec<(u32, u32)>, bodies: usize) {
+    pub(crate) fn sort_pairs(&mut self, out: &mut Vec<(u32, u32)>, bodies: usize) {
         if out.len() <= SMALL_SORT {
             out.sort_unstable(); // a robot's few pairs: cheaper than two counting passes
             return;
@@ -213,29 +249,6 @@ impl BroadPhase {
             let at = &mut starts[h as usize];
             self.sorted[*at as usize] = (h, cell, body);
             *at += 1;
-        }
-    }
-
-    /// Twice the median extent of the present boxes (1 when that is not a positive
-    /// number: all of them points).
-    fn cell_size(&mut self, boxes: &[Option<Aabb>]) -> f64 {
-        self.extents.clear();
-        self.extents.extend(
-            boxes
-                .iter()
-                .flatten()
-                .map(|b| (b.max.x - b.min.x).max(b.max.y - b.min.y)),
-        );
-        if self.extents.is_empty() {
-            return 1.0;
-        }
-        let middle = self.extents.len() / 2;
-        let (_, median, _) = self.extents.select_nth_unstable_by(middle, f64::total_cmp);
-        let cell = 2.0 * *median;
-        if cell.is_finite() && cell > 0.0 {
-            cell
-        } else {
-            1.0
         }
     }
 }

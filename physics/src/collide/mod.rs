@@ -1,12 +1,14 @@
 //! Collision detection: bounds, the broad phase and the SAT narrow phase (SPEC §3.1).
 
 mod broad;
+mod fixed_cells;
 mod pair_set;
 pub(crate) mod reuse;
 pub(crate) mod sat;
 pub(crate) mod toi;
 
 pub(crate) use broad::BroadPhase;
+pub(crate) use fixed_cells::FixedCells;
 pub(crate) use pair_set::PairSet;
 pub(crate) use sat::collide_polygons_into;
 

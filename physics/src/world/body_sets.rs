@@ -70,6 +70,12 @@ impl BodySets {
         &self.statics
     }
 
+    /// The sleeping bodies (current after `refresh`).
+    pub(super) fn sleeping(&self) -> &[u32] {
+        debug_assert!(!self.stale, "read before refresh");
+        &self.sleeping
+    }
+
     /// Whether some body is asleep, and whether some body is awake (current after
     /// `refresh`).
     pub(super) fn some_asleep_and_awake(&self) -> (bool, bool) {

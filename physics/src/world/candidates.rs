@@ -5,7 +5,7 @@
 use super::World;
 use crate::body::Body;
 use crate::collide::reuse::Pose;
-use crate::collide::{Aabb, WorldPolygon};
+use crate::collide::{Aabb, FixedCells, WorldPolygon};
 use crate::math::Vec2;
 
 /// While the broad phase pairs the bodies again every time, every this many pairings use
@@ -14,6 +14,10 @@ const RETRY_GROWN_BOUNDS: u32 = 8;
 
 /// nearer ones stand between.
 const MAX_NEIGHBOURS: f64 = 32.0;
+
+/// From this many static and sleeping bodies on, they are kept in cells of their own
+/// (`FixedCells`) and only the moving bodies are gridded at each pairing.
+const FIXED_CELLS_FROM: usize = 64;
 
 /// How much of body `i`'s room for neighbours body `j` takes: 1 for a body at least its
 /// size, by bounding radius, and less for a smaller one.
@@ -127,6 +131,12 @@ pub(super) struct KeptPairs {
     /// Whether some moving body has more than `MAX_NEIGHBOURS` moving neighbours among
     /// the pairs.
     crowded: bool,
+    /// The static and sleeping bodies in cells of their own, and the bounds they were
+    /// listed with (`bounds_seen`'s key and the growth, in bits); the fixed bodies, as
+    /// scratch.
+    fixed_cells: FixedCells,
+    fixed_cells_for: Option<((u64, u64, u64), u64)>,
+    fixed_slots: Vec<u32>,
 }
 
 impl KeptPairs {
@@ -135,6 +145,7 @@ impl KeptPairs {
         self.bounds.clear();
         self.fixed.clear();
         self.pairs.clear();
+        self.fixed_cells_for = None;
     }
 }
 
@@ -284,7 +295,26 @@ impl World {
                 let both_fixed = fixed[i] & fixed[j];
                 !both_fixed && !non_colliding.contains((i as u32, j as u32))
             };
-            s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
+            let fixed_slots = &mut kept.fixed_slots;
+            fixed_slots.clear();
+            fixed_slots.extend_from_slice(self.sets.statics());
+            fixed_slots.extend_from_slice(self.sets.sleeping());
+            if fixed_slots.len() < FIXED_CELLS_FROM {
+                s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
+            } else {
+                fixed_slots.sort_unstable();
+                let listed_with = (seen, grow.to_bits());
+                if kept.fixed_cells_for != Some(listed_with) {
+                    kept.fixed_cells.build(&kept.bounds, fixed_slots);
+                    kept.fixed_cells_for = Some(listed_with);
+                }
+                let moving = self.sets.awake();
+                s.broad_phase
+                    .pairs_among(&kept.bounds, moving, wanted, &mut kept.pairs);
+                kept.fixed_cells
+                    .pairs_with(&kept.bounds, moving, wanted, &mut kept.pairs);
+                s.broad_phase.sort_pairs(&mut kept.pairs, n);
+            }
             s.radii.clear();
             s.radii.extend(
                 bodies
