@@ -60,6 +60,18 @@ pub(super) fn cells_of(b: &Aabb, per_cell: f64) -> (((i64, i64), (i64, i64)), bo
     (((x0, y0), (x1, y1)), (1..=MAX_CELLS).contains(&covered))
 }
 
+/// The bits of a cell hash for `entries` entries: about two buckets per entry.
+pub(super) fn hash_bits(entries: usize) -> u32 {
+    (2 * entries).next_power_of_two().trailing_zeros().max(1)
+}
+
+/// A cell's bucket among `1 << bits`.
+pub(super) fn cell_hash((x, y): (i64, i64), bits: u32) -> u32 {
+    let mixed = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+    (mixed >> (64 - bits)) as u32
+}
+
 /// Twice the median extent of the boxes of `slots` (1 when that is not a positive number:
 /// all of them points); `extents` is scratch.
 pub(super) fn cell_size(boxes: &[Option<Aabb>], slots: &[u32], extents: &mut Vec<f64>) -> f64 {
@@ -225,15 +237,8 @@ impl BroadPhase {
     /// sort; a comparison sort of the entries cost more than all of the pairing). Each
     /// group keeps the entries' body order.
     fn group_by_cell(&mut self) {
-        let bits = (2 * self.entries.len())
-            .next_power_of_two()
-            .trailing_zeros()
-            .max(1);
-        let hash = |(x, y): (i64, i64)| {
-            let mixed = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-                ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
-            (mixed >> (64 - bits)) as u32
-        };
+        let bits = hash_bits(self.entries.len());
+        let hash = |cell| cell_hash(cell, bits);
         let starts = &mut self.bucket_starts;
         starts.clear();
         starts.resize((1 << bits) + 1, 0);

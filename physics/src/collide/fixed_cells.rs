@@ -4,14 +4,19 @@
 //! a tree of their own): a terrain of 2,000 tiles is listed once, not at every pairing.
 
 use super::Aabb;
-use super::broad::{cell_size, cells_of};
+use super::broad::{cell_hash, cell_size, cells_of, hash_bits};
 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct FixedCells {
     per_cell: f64,
     /// `(cell, body, the body's lower corner cell)` for every cell each small fixed body
-    /// covers, sorted by cell, then body.
+    /// covers, grouped by the cell's hash (`bits` of it), each group in body order;
+    /// group `h` is `entries[starts[h]..starts[h + 1]]`.
     entries: Vec<((i64, i64), u32, (i64, i64))>,
+    bits: u32,
+    starts: Vec<u32>,
+    next: Vec<u32>,
+    unsorted: Vec<((i64, i64), u32, (i64, i64))>,
     /// The fixed bodies covering more than `broad::MAX_CELLS` cells (a floor), compared
     /// with every moving body, and all the fixed bodies, compared one by one with a moving
     /// body that large.
@@ -25,7 +30,8 @@ impl FixedCells {
     /// their median size.
     pub(crate) fn build(&mut self, boxes: &[Option<Aabb>], fixed: &[u32]) {
         self.per_cell = 1.0 / cell_size(boxes, fixed, &mut self.extents);
-        self.entries.clear();
+        let unsorted = &mut self.unsorted;
+        unsorted.clear();
         self.large.clear();
         self.all.clear();
         self.all.extend_from_slice(fixed);
@@ -37,12 +43,28 @@ impl FixedCells {
                 continue;
             }
             for x in x0..=x1 {
-                self.entries
-                    .extend((y0..=y1).map(|y| ((x, y), f, (x0, y0))));
+                unsorted.extend((y0..=y1).map(|y| ((x, y), f, (x0, y0))));
             }
         }
-        // Each cell's bodies increasing.
-        self.entries.sort_unstable_by_key(|e| (e.0, e.1));
+        // Grouped by a counting sort on the cell's hash, which keeps the body order.
+        self.bits = hash_bits(unsorted.len());
+        let starts = &mut self.starts;
+        starts.clear();
+        starts.resize((1 << self.bits) + 1, 0);
+        for e in unsorted.iter() {
+            starts[cell_hash(e.0, self.bits) as usize + 1] += 1;
+        }
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        self.entries.clear();
+        self.entries.resize(unsorted.len(), ((0, 0), 0, (0, 0)));
+        self.next.clone_from(starts);
+        for &e in unsorted.iter() {
+            let at = &mut self.next[cell_hash(e.0, self.bits) as usize];
+            self.entries[*at as usize] = e;
+            *at += 1;
+        }
     }
 
     /// Appends `(i, j)`, `i < j`, for each body of `moving` and fixed body whose boxes
@@ -76,10 +98,9 @@ impl FixedCells {
             for x in x0..=x1 {
                 for y in y0..=y1 {
                     let cell = (x, y);
-                    let first = self.entries.partition_point(|e| e.0 < cell);
-                    for &(_, f, (fx0, fy0)) in
-                        self.entries[first..].iter().take_while(|e| e.0 == cell)
-                    {
+                    let h = cell_hash(cell, self.bits) as usize;
+                    let group = self.starts[h] as usize..self.starts[h + 1] as usize;
+                    for &(_, f, (fx0, fy0)) in self.entries[group].iter().filter(|e| e.0 == cell) {
                         // Of the cells both cover, the pair is met in one only: that of
                         // their overlap's lower corner.
                         if (x0.max(fx0), y0.max(fy0)) == cell {

@@ -2,8 +2,105 @@
 //! goes back along its path to its time of impact, its joint island with it.
 
 use super::World;
-use crate::collide::Aabb;
+use super::body_sets::{BodySets, EpochSeen};
+use crate::body::Body;
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
+use crate::collide::{Aabb, WorldPolygon};
+
+/// The static bodies as obstacles, kept while the sets stay: each one's slot, outline,
+/// bounds and place, and an index of them by their bounds' left edge, for finding those
+/// a sweep passes over without looking at every one (a terrain of 2,000 tiles).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Obstacles {
+    list: Vec<(u32, WorldPolygon, Aabb, [u64; 3])>,
+    /// The narrow obstacles' left edges and `list` indices, increasing, and the widest
+    /// of them.
+    by_left_edge: Vec<(f64, u32)>,
+    widest: f64,
+    /// The wide ones (over `WIDE` times the median width: a floor), met by every sweep.
+    wide: Vec<u32>,
+    widths: Vec<f64>,
+    seen: EpochSeen,
+}
+
+/// An obstacle this many times wider than the median one is not in the index by left
+/// edge: it would widen every search.
+const WIDE: f64 = 4.0;
+
+impl Obstacles {
+    /// The static bodies listed again if the sets changed since the last time.
+    fn list_again_if_changed(&mut self, sets: &BodySets, bodies: &[Option<Body>]) {
+        if !self.seen.sets_changed(sets) {
+            return;
+        }
+        let mut n = 0;
+        for &slot in sets.statics() {
+            let obstacle = bodies[slot as usize].as_ref().expect("a static body");
+            if self.list.len() == n {
+                self.list.push(Default::default());
+            }
+            let (index, polygon, bounds, placed_at) = &mut self.list[n];
+            // The same static body where it was placed last time has the same outline:
+            // a terrain of many is not turned again whenever the sets change.
+            let place = obstacle.place();
+            if *index != slot || *placed_at != place || polygon.vertices.is_empty() {
+                *index = slot;
+                polygon.update(obstacle);
+                *bounds = polygon.aabb();
+                *placed_at = place;
+            }
+            n += 1;
+        }
+        self.list.truncate(n);
+        let width = |b: &Aabb| b.max.x - b.min.x;
+        self.widths.clear();
+        self.widths
+            .extend(self.list.iter().map(|(_, _, b, _)| width(b)));
+        let median = if self.widths.is_empty() {
+            0.0
+        } else {
+            let middle = self.widths.len() / 2;
+            *self.widths.select_nth_unstable_by(middle, f64::total_cmp).1
+        };
+        self.by_left_edge.clear();
+        self.wide.clear();
+        self.widest = 0.0;
+        for (k, (_, _, b, _)) in self.list.iter().enumerate() {
+            // Not narrow unless finite and at most `WIDE` medians wide (NaN: wide).
+            if width(b) <= WIDE * median {
+                self.by_left_edge.push((b.min.x, k as u32));
+                self.widest = self.widest.max(width(b));
+            } else {
+                self.wide.push(k as u32);
+            }
+        }
+        self.by_left_edge
+            .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    }
+
+    /// The obstacles whose bounds overlap `swept`: the wide ones, then the narrow ones by
+    /// left edge (the order does not matter to the earliest impact).
+    fn near<'a>(
+        &'a self,
+        swept: &'a Aabb,
+    ) -> impl Iterator<Item = &'a (u32, WorldPolygon, Aabb, [u64; 3])> + 'a {
+        // A narrow obstacle that reaches `swept` starts at most `widest` left of it (twice
+        // that, against the rounding of the widths).
+        let from = self
+            .by_left_edge
+            .partition_point(|&(left, _)| left < swept.min.x - 2.0 * self.widest);
+        let narrow = self.by_left_edge[from..]
+            .iter()
+            .take_while(|&&(left, _)| left <= swept.max.x)
+            .map(|&(_, k)| k);
+        self.wide
+            .iter()
+            .copied()
+            .chain(narrow)
+            .map(|k| &self.list[k as usize])
+            .filter(|(_, _, bounds, _)| swept.overlaps(bounds))
+    }
+}
 
 impl World {
     /// Continuous collision: see `step`.
@@ -11,10 +108,10 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch;
-        // The static bodies' slots, outlines and bounds, looked at when the first body
-        // needs them (most steps, none does), and built again only if the sets changed.
+        // The static bodies, looked at when the first body needs them (most steps, none
+        // does), and listed again only if the sets changed.
         let mut obstacles = std::mem::take(&mut s.obstacles);
-        let mut count: Option<usize> = None;
+        let mut listed = false;
         s.impacts.clear();
         for &i in self.sets.awake() {
             let i = i as usize;
@@ -41,31 +138,9 @@ impl World {
             {
                 continue;
             }
-            let count = *count.get_or_insert_with(|| {
-                if !s.obstacles_seen.sets_changed(&self.sets) {
-                    return obstacles.len();
-                }
-                let mut n = 0;
-                for &slot in self.sets.statics() {
-                    let obstacle = self.bodies[slot as usize].as_ref().expect("a static body");
-                    if obstacles.len() == n {
-                        obstacles.push(Default::default());
-                    }
-                    let (index, polygon, bounds, placed_at) = &mut obstacles[n];
-                    // The same static body where it was placed last time has the same
-                    // outline: a terrain of many is not turned again at every fast body.
-                    let place = obstacle.place();
-                    if *index != slot || *placed_at != place || polygon.vertices.is_empty() {
-                        *index = slot;
-                        polygon.update(obstacle);
-                        *bounds = polygon.aabb();
-                        *placed_at = place;
-                    }
-                    n += 1;
-                }
-                obstacles.truncate(n);
-                n
-            });
+            if !std::mem::replace(&mut listed, true) {
+                obstacles.list_again_if_changed(&self.sets, &self.bodies);
+            }
             let swept = Aabb {
                 min: sweep.start.0.inf(&sweep.end.0),
                 max: sweep.start.0.sup(&sweep.end.0),
@@ -77,10 +152,7 @@ impl World {
             // none at all), and placing both cost 7% of the smash's step.
             let (mut placed_at_end, mut placed_at_start) = (false, false);
             let mut first: Option<f64> = None;
-            for (obstacle, polygon, bounds, _) in &obstacles[..count] {
-                if !swept.overlaps(bounds) {
-                    continue;
-                }
+            for (obstacle, polygon, _, _) in obstacles.near(&swept) {
                 // A static body this one never collides with (a robot's pivot that its
                 // own links pass over) is no obstacle.
                 let pair = ((i as u32).min(*obstacle), (i as u32).max(*obstacle));

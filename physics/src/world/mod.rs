@@ -19,6 +19,7 @@ use settings::{Integrator, StepSettings};
 use auto::{AutoMemory, IslandNeeds};
 use body_sets::{BodySets, EpochSeen};
 use candidates::{KeptPairs, NeighbourScratch};
+use continuous::Obstacles;
 use solver_bodies::GapTargets;
 use stats::StepStats;
 
@@ -283,12 +284,11 @@ struct Scratch {
     mover_at_end: WorldPolygon,
     mover_at_start: WorldPolygon,
     toi_scratch: WorldPolygon,
-    /// Continuous collision: static bodies' slots, outlines and bounds; the bodies
-    /// stopped and their times of impact; joint islands and each island's earliest impact.
-    obstacles: Vec<(u32, WorldPolygon, Aabb, [u64; 3])>,
-    obstacles_seen: EpochSeen,
     /// When every body's forces were last cleared (`clear_forces`).
     forces_seen: EpochSeen,
+    /// Continuous collision: the static bodies as obstacles; the bodies stopped and their
+    /// times of impact; joint islands and each island's earliest impact.
+    obstacles: Obstacles,
     impacts: Vec<(u32, f64)>,
     impact_union: UnionFind,
     island_impact: Vec<f64>,
