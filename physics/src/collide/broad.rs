@@ -50,14 +50,28 @@ pub(super) fn cell_of(v: f64, per_cell: f64) -> i64 {
     truncated - i64::from(t < truncated as f64)
 }
 
-/// The cells a box covers, `((x0, y0), (x1, y1))`, and whether it covers no more than
-/// `MAX_CELLS` (else it is compared with every body instead of being listed).
-pub(super) fn cells_of(b: &Aabb, per_cell: f64) -> (((i64, i64), (i64, i64)), bool) {
+/// A grid cell: its column and row.
+pub(super) type Cell = (i64, i64);
+
+/// The cells a box covers: from `lower` to `upper` (corners, inclusive), and whether
+/// that is no more than `MAX_CELLS` (else the box is compared with every body instead of
+/// being listed).
+pub(super) struct CellRange {
+    pub(super) lower: Cell,
+    pub(super) upper: Cell,
+    pub(super) small: bool,
+}
+
+pub(super) fn cells_of(b: &Aabb, per_cell: f64) -> CellRange {
     let (x0, x1) = (cell_of(b.min.x, per_cell), cell_of(b.max.x, per_cell));
     let (y0, y1) = (cell_of(b.min.y, per_cell), cell_of(b.max.y, per_cell));
     let span = |lo: i64, hi: i64| hi.saturating_sub(lo).saturating_add(1);
     let covered = span(x0, x1).saturating_mul(span(y0, y1));
-    (((x0, y0), (x1, y1)), (1..=MAX_CELLS).contains(&covered))
+    CellRange {
+        lower: (x0, y0),
+        upper: (x1, y1),
+        small: (1..=MAX_CELLS).contains(&covered),
+    }
 }
 
 /// The bits of a cell hash for `entries` entries: about two buckets per entry.
@@ -66,7 +80,7 @@ pub(super) fn hash_bits(entries: usize) -> u32 {
 }
 
 /// A cell's bucket among `1 << bits`.
-pub(super) fn cell_hash((x, y): (i64, i64), bits: u32) -> u32 {
+pub(super) fn cell_hash((x, y): Cell, bits: u32) -> u32 {
     let mixed = (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
         ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
     (mixed >> (64 - bits)) as u32
@@ -141,7 +155,11 @@ impl BroadPhase {
         self.lower_cells.resize(boxes.len(), (0, 0));
         for &i in slots {
             let b = boxes[i as usize].expect("present");
-            let (((x0, y0), (x1, y1)), small) = cells_of(&b, per_cell);
+            let CellRange {
+                lower: (x0, y0),
+                upper: (x1, y1),
+                small,
+            } = cells_of(&b, per_cell);
             if !small {
                 self.large.push(i);
                 self.is_large[i as usize] = true;

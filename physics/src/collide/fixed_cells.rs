@@ -4,19 +4,27 @@
 //! a tree of their own): a terrain of 2,000 tiles is listed once, not at every pairing.
 
 use super::Aabb;
-use super::broad::{cell_hash, cell_size, cells_of, hash_bits};
+use super::broad::{Cell, CellRange, cell_hash, cell_size, cells_of, hash_bits};
+
+/// A fixed body listed in a cell, with the lower corner cell of those it covers.
+#[derive(Debug, Clone, Copy, Default)]
+struct Entry {
+    cell: Cell,
+    body: u32,
+    lower: Cell,
+}
 
 #[derive(Debug, Clone, Default)]
 pub(crate) struct FixedCells {
     per_cell: f64,
-    /// `(cell, body, the body's lower corner cell)` for every cell each small fixed body
-    /// covers, grouped by the cell's hash (`bits` of it), each group in body order;
-    /// group `h` is `entries[starts[h]..starts[h + 1]]`.
-    entries: Vec<((i64, i64), u32, (i64, i64))>,
+    /// An entry for every cell each small fixed body covers, grouped by the cell's hash
+    /// (`bits` of it), each group in body order; group `h` is
+    /// `entries[starts[h]..starts[h + 1]]`.
+    entries: Vec<Entry>,
     bits: u32,
     starts: Vec<u32>,
     next: Vec<u32>,
-    unsorted: Vec<((i64, i64), u32, (i64, i64))>,
+    unsorted: Vec<Entry>,
     /// The fixed bodies covering more than `broad::MAX_CELLS` cells (a floor), compared
     /// with every moving body, and all the fixed bodies, compared one by one with a moving
     /// body that large.
@@ -37,13 +45,21 @@ impl FixedCells {
         self.all.extend_from_slice(fixed);
         for &f in fixed {
             let b = boxes[f as usize].expect("a fixed body with bounds");
-            let (((x0, y0), (x1, y1)), small) = cells_of(&b, self.per_cell);
+            let CellRange {
+                lower: (x0, y0),
+                upper: (x1, y1),
+                small,
+            } = cells_of(&b, self.per_cell);
             if !small {
                 self.large.push(f);
                 continue;
             }
             for x in x0..=x1 {
-                unsorted.extend((y0..=y1).map(|y| ((x, y), f, (x0, y0))));
+                unsorted.extend((y0..=y1).map(|y| Entry {
+                    cell: (x, y),
+                    body: f,
+                    lower: (x0, y0),
+                }));
             }
         }
         // Grouped by a counting sort on the cell's hash, which keeps the body order.
@@ -52,16 +68,16 @@ impl FixedCells {
         starts.clear();
         starts.resize((1 << self.bits) + 1, 0);
         for e in unsorted.iter() {
-            starts[cell_hash(e.0, self.bits) as usize + 1] += 1;
+            starts[cell_hash(e.cell, self.bits) as usize + 1] += 1;
         }
         for k in 1..starts.len() {
             starts[k] += starts[k - 1];
         }
         self.entries.clear();
-        self.entries.resize(unsorted.len(), ((0, 0), 0, (0, 0)));
+        self.entries.resize(unsorted.len(), Entry::default());
         self.next.clone_from(starts);
         for &e in unsorted.iter() {
-            let at = &mut self.next[cell_hash(e.0, self.bits) as usize];
+            let at = &mut self.next[cell_hash(e.cell, self.bits) as usize];
             self.entries[*at as usize] = e;
             *at += 1;
         }
@@ -85,7 +101,11 @@ impl FixedCells {
         };
         for &m in moving {
             let bm = boxes[m as usize].expect("a moving body with bounds");
-            let (((x0, y0), (x1, y1)), small) = cells_of(&bm, self.per_cell);
+            let CellRange {
+                lower: (x0, y0),
+                upper: (x1, y1),
+                small,
+            } = cells_of(&bm, self.per_cell);
             if !small {
                 for &f in &self.all {
                     keep(m, f, &bm, out);
@@ -100,11 +120,11 @@ impl FixedCells {
                     let cell = (x, y);
                     let h = cell_hash(cell, self.bits) as usize;
                     let group = self.starts[h] as usize..self.starts[h + 1] as usize;
-                    for &(_, f, (fx0, fy0)) in self.entries[group].iter().filter(|e| e.0 == cell) {
+                    for e in self.entries[group].iter().filter(|e| e.cell == cell) {
                         // Of the cells both cover, the pair is met in one only: that of
                         // their overlap's lower corner.
-                        if (x0.max(fx0), y0.max(fy0)) == cell {
-                            keep(m, f, &bm, out);
+                        if (x0.max(e.lower.0), y0.max(e.lower.1)) == cell {
+                            keep(m, e.body, &bm, out);
                         }
                     }
                 }
@@ -150,7 +170,7 @@ mod tests {
             let present = |i: &u32| boxes[*i as usize].is_some();
             let fixed: Vec<u32> = (0..400).filter(|i| i % 3 != 0).filter(present).collect();
             let moving: Vec<u32> = (0..400).filter(|i| i % 3 == 0).filter(present).collect();
-            let wanted = |i: usize, j: usize| (i + 2 * j) % 13 != 0;
+            let wanted = |i: usize, j: usize| !(i + 2 * j).is_multiple_of(13);
             let mut cells = FixedCells::default();
             cells.build(&boxes, &fixed);
             let mut found = vec![];
