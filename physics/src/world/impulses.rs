@@ -24,21 +24,21 @@ impl World {
             .for_each(f);
     }
 
+    /// The awake bodies' poses and velocities, for `restore_state` (the step moves no
+    /// other body).
     pub(super) fn save_state(&mut self) {
         let saved = &mut self.scratch.saved_state;
         saved.clear();
-        saved.extend(self.bodies.iter().map(|b| {
-            b.as_ref().map_or(Default::default(), |b| {
-                (b.position, b.angle, b.velocity, b.angular_velocity)
-            })
+        saved.extend(self.sets.awake().iter().map(|&i| {
+            let b = self.bodies[i as usize].as_ref().expect("an awake body");
+            (b.position, b.angle, b.velocity, b.angular_velocity)
         }));
     }
 
     pub(super) fn restore_state(&mut self) {
-        for (body, &(p, a, v, w)) in self.bodies.iter_mut().zip(&self.scratch.saved_state) {
-            if let Some(b) = body {
-                (b.position, b.angle, b.velocity, b.angular_velocity) = (p, a, v, w);
-            }
+        for (&i, &(p, a, v, w)) in self.sets.awake().iter().zip(&self.scratch.saved_state) {
+            let b = self.bodies[i as usize].as_mut().expect("an awake body");
+            (b.position, b.angle, b.velocity, b.angular_velocity) = (p, a, v, w);
         }
     }
 

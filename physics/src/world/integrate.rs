@@ -17,17 +17,29 @@ impl World {
     }
 
     /// Gravity and accumulated forces change velocities (SPEC §3.4 steps 2–3).
+    /// (Every body's velocity is kept in `start_velocities` first, for restitution: the
+    /// awake bodies' each time, the others' when the sets change.)
     pub(super) fn integrate_velocities(&mut self, dt: f64) {
-        self.scratch.start_velocities.clear();
-        self.scratch
-            .start_velocities
-            .extend(self.bodies.iter().map(|b| {
-                b.as_ref()
-                    .map_or((Vec2::zeros(), 0.0), |b| (b.velocity, b.angular_velocity))
-            }));
-        for b in self.bodies.iter_mut().flatten() {
+        let s = &mut self.scratch;
+        let velocity = |b: &Body| (b.velocity, b.angular_velocity);
+        let changed = s.start_velocities_seen.sets_changed(&self.sets);
+        if changed || s.start_velocities.len() != self.bodies.len() {
+            s.start_velocities.clear();
+            s.start_velocities.extend(
+                self.bodies
+                    .iter()
+                    .map(|b| b.as_ref().map_or((Vec2::zeros(), 0.0), velocity)),
+            );
+        } else {
+            for &i in self.sets.awake() {
+                let b = self.bodies[i as usize].as_ref().expect("an awake body");
+                s.start_velocities[i as usize] = velocity(b);
+            }
+        }
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_mut().expect("an awake body");
             if b.is_fixed() {
-                continue;
+                continue; // held by `auto` for this pass
             }
             b.velocity += (self.gravity + b.force * b.inv_mass) * dt;
             b.angular_velocity += b.torque * b.inv_inertia * dt;
@@ -38,9 +50,10 @@ impl World {
     pub(super) fn integrate_positions(&mut self, dt: f64) {
         let gravity = self.gravity;
         let explicit = self.settings.integrator == Integrator::ExplicitEuler;
-        for b in self.bodies.iter_mut().flatten() {
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_mut().expect("an awake body");
             if b.is_fixed() {
-                continue;
+                continue; // held by `auto` for this pass
             }
             let (v, w) = if explicit {
                 // Undo this step's force contribution: the position uses the old velocity,

@@ -268,8 +268,10 @@ struct Scratch {
     /// a collision may turn each body off its course (`drop_idle_manifolds`).
     gaps: Vec<f64>,
     turn_off: Vec<f64>,
-    /// Velocities before this step's forces, for restitution.
+    /// Velocities before this step's forces, for restitution, and when those of the
+    /// static and sleeping bodies were taken.
     start_velocities: Vec<(Vec2, f64)>,
+    start_velocities_seen: EpochSeen,
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
     joint_constraints: Vec<JointConstraint>,
