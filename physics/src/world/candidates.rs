@@ -4,9 +4,7 @@
 
 use super::World;
 use crate::body::Body;
-use crate::collide::reuse::Pose;
-use crate::collide::{Aabb, FixedCells, WorldPolygon};
-use crate::math::Vec2;
+use crate::collide::{Aabb, FixedCells};
 
 /// While the broad phase pairs the bodies again every time, every this many pairings use
 /// grown bounds, to see whether they hold again (`find_candidate_pairs`).
@@ -149,22 +147,6 @@ impl KeptPairs {
     }
 }
 
-/// The slots whose bounds a step looks at: every one, or the awake bodies'.
-enum Slots<'a> {
-    Every(std::ops::Range<u32>),
-    Awake(std::slice::Iter<'a, u32>),
-}
-
-impl Iterator for Slots<'_> {
-    type Item = u32;
-    fn next(&mut self) -> Option<u32> {
-        match self {
-            Slots::Every(range) => range.next(),
-            Slots::Awake(slots) => slots.next().copied(),
-        }
-    }
-}
-
 impl World {
     pub(super) fn refresh_collision_filter(&mut self) {
         if !std::mem::take(&mut self.collision_filter_stale) {
@@ -205,66 +187,22 @@ impl World {
         let margin = self.settings.contact_margin();
         let is_fixed =
             |body: &Option<Body>| body.as_ref().is_none_or(|b| b.is_static() || b.is_asleep());
-        // Static and sleeping bodies keep what they were given when the sets last changed
-        // (their speed, if any, was counted at this step length and margin); the awake
-        // ones are looked at again.
-        let seen = (self.sets.epoch(), dt.to_bits(), margin.to_bits());
-        let every_body = s.bounds_seen != Some(seen) || s.boxes.len() != n;
-        if every_body {
-            s.bounds_seen = Some(seen);
-            s.polygons.resize_with(n, WorldPolygon::default);
-            s.outlined_at.resize(n, None);
-            s.boxes.resize(n, None);
-            s.reach.resize(n, 0.0);
-            s.motion.resize(n, (Vec2::zeros(), 0.0));
-            s.poses.resize(n, Pose::default());
-        }
+        let mut made = self.bounds.make(&self.bodies, &self.sets, dt, margin);
         // The grown bounds' pairs still hold every pair whose bounds overlap now if every
-        // body's bounds lie inside its grown ones, and the same bodies are fixed: checked
-        // as the bounds are made. Bodies not looked at are as they were when last checked.
-        let mut still_inside = kept.bounds.len() == n;
-        let mut same_fixed = kept.fixed.len() == n;
-        let looked_at = if every_body {
-            Slots::Every(0..n as u32)
-        } else {
-            Slots::Awake(self.sets.awake().iter())
-        };
-        for i in looked_at {
-            let i = i as usize;
-            let body = &self.bodies[i];
-            // The speed of its farthest point from the spin alone.
-            let spin = body
-                .as_ref()
-                .map_or(0.0, |b| b.angular_velocity.abs() * b.bounding_radius());
-            let velocity = body.as_ref().map_or(Vec2::zeros(), |b| b.velocity);
-            let reach = (velocity.norm() + spin) * dt;
-            s.reach[i] = reach;
-            s.motion[i] = (velocity * dt, spin * dt);
-            let (polygon, outlined_at) = (&mut s.polygons[i], &mut s.outlined_at[i]);
-            let outline = body.as_ref().map(|b| {
-                // A body where it was when its outline was last made (a static one, one
-                // asleep, one at rest to the last bit) keeps that outline, its normals,
-                // its pose and its bounds: the same numbers, without turning it again.
-                let place = b.place();
-                if outlined_at.is_none_or(|(at, ..)| at != place) {
-                    let pose = Pose::of(b);
-                    polygon.set_outline(b.local_vertices().iter().map(|&v| pose.to_world(v)));
-                    *outlined_at = Some((place, pose, polygon.aabb()));
-                }
-                outlined_at.expect("set above")
-            });
-            s.poses[i] = outline.map_or(Pose::default(), |(_, pose, _)| pose);
-            let bounds = outline.map(|(.., aabb)| aabb.grown(0.5 * margin + reach));
-            if still_inside {
-                still_inside = match (&bounds, &kept.bounds[i]) {
+        // body's bounds lie inside its grown ones, and the same bodies are fixed. Bodies
+        // whose bounds were not made again are as they were when last checked.
+        let bounds = &self.bounds;
+        let still_inside = kept.bounds.len() == n
+            && made.clone().all(|i| {
+                match (&bounds.boxes[i as usize], &kept.bounds[i as usize]) {
                     (Some(now), Some(fat)) => fat.contains(now),
                     (None, None) => true,
                     _ => false,
-                };
-            }
-            same_fixed = same_fixed && kept.fixed[i] == is_fixed(body);
-            s.boxes[i] = bounds;
-        }
+                }
+            });
+        let same_fixed = kept.fixed.len() == n
+            && made.all(|i| kept.fixed[i as usize] == is_fixed(&self.bodies[i as usize]));
+        let made_for = bounds.made_for().expect("made above");
         let bodies = &self.bodies;
         // Pairs of static or sleeping bodies are never tested: a pile at rest costs nothing.
         // The broad phase leaves out such pairs only, not those of bodies held for one pass
@@ -287,7 +225,7 @@ impl World {
             };
             kept.bounds.clear();
             kept.bounds
-                .extend(s.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
+                .extend(bounds.boxes.iter().map(|b| b.map(|b| b.grown(grow))));
             kept.fixed.clear();
             kept.fixed.extend(bodies.iter().map(is_fixed));
             let (non_colliding, fixed) = (&self.non_colliding, &kept.fixed);
@@ -303,7 +241,7 @@ impl World {
                 s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
             } else {
                 fixed_slots.sort_unstable();
-                let listed_with = (seen, grow.to_bits());
+                let listed_with = (made_for, grow.to_bits());
                 if kept.fixed_cells_for != Some(listed_with) {
                     kept.fixed_cells.build(&kept.bounds, fixed_slots);
                     kept.fixed_cells_for = Some(listed_with);
@@ -325,7 +263,7 @@ impl World {
             kept.crowded = crowded(&kept.pairs, fixed, &s.radii, room_taken);
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
-        let boxes = &s.boxes;
+        let boxes = &bounds.boxes;
         let overlap = |&(i, j): &(u32, u32)| match (&boxes[i as usize], &boxes[j as usize]) {
             (Some(a), Some(b)) => a.overlaps(b),
             _ => false,
@@ -349,8 +287,8 @@ impl World {
         if kept.crowded {
             s.grown_by.clear();
             s.grown_by
-                .extend(s.reach.iter().map(|reach| 0.5 * margin + reach));
-            let sizes = (&s.boxes[..], &s.grown_by[..], &s.radii[..]);
+                .extend(bounds.reach.iter().map(|reach| 0.5 * margin + reach));
+            let sizes = (&bounds.boxes[..], &s.grown_by[..], &s.radii[..]);
             keep_nearest_neighbours(&mut s.pairs, &kept.fixed, sizes, &mut s.neighbours);
         }
     }
@@ -361,6 +299,7 @@ mod tests {
     use super::super::tests::overlapping_pairs;
     use super::*;
     use crate::body::BodyDef;
+    use crate::math::Vec2;
     use crate::shape::ConvexPolygon;
     use crate::solver::ContactSolver;
 
@@ -444,7 +383,7 @@ mod tests {
             let s = &world.scratch;
             if world.kept_pairs.bounds == before {
                 kept += 1;
-            } else if world.kept_pairs.bounds == s.boxes {
+            } else if world.kept_pairs.bounds == world.bounds.boxes {
                 bare += 1;
             } else {
                 grown += 1;

@@ -54,8 +54,8 @@ impl World {
         }
         for &(i, j) in &s.pairs {
             let (a, b) = (BodyHandle(i), BodyHandle(j));
-            let (pose_a, pose_b) = (&s.poses[i as usize], &s.poses[j as usize]);
-            let pair_margin = margin + s.reach[i as usize] + s.reach[j as usize];
+            let (pose_a, pose_b) = (&self.bounds.poses[i as usize], &self.bounds.poses[j as usize]);
+            let pair_margin = margin + self.bounds.reach[i as usize] + self.bounds.reach[j as usize];
             // A reused manifold is made in its place in the list (`reuse_into`).
             let limits = (pair_margin, reuse_tolerance);
             if self.settings.reuse_manifolds
@@ -63,18 +63,18 @@ impl World {
             {
                 continue;
             }
-            s.polygons[i as usize].ensure_normals();
-            s.polygons[j as usize].ensure_normals();
+            self.bounds.polygons[i as usize].ensure_normals();
+            self.bounds.polygons[j as usize].ensure_normals();
             let found = collide_polygons_into(
-                (a, &s.polygons[i as usize]),
-                (b, &s.polygons[j as usize]),
+                (a, &self.bounds.polygons[i as usize]),
+                (b, &self.bounds.polygons[j as usize]),
                 (pair_margin, tie),
                 &mut self.manifolds,
             );
             // A pair that may move past the reuse tolerance in this step will not be reused
             // at the next one: the smash's debris found ~50,000 manifolds a step and reused
             // ~1,300.
-            let (motion_a, motion_b) = (s.motion[i as usize], s.motion[j as usize]);
+            let (motion_a, motion_b) = (self.bounds.motion[i as usize], self.bounds.motion[j as usize]);
             if found
                 && self.settings.reuse_manifolds
                 && !relative_reach_exceeds(motion_a, motion_b, reuse_tolerance)
@@ -145,7 +145,7 @@ impl World {
     /// 0.12 m deep.
     fn drop_idle_manifolds(&mut self, margin: f64) {
         let s = &mut self.scratch;
-        let motion = &s.motion;
+        let motion = &self.bounds.motion;
         let gap_after = |m: &Manifold| {
             let (a, b) = (motion[m.body_a.index()], motion[m.body_b.index()]);
             -m.depth() - relative_reach(a, b)

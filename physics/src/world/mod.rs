@@ -4,6 +4,7 @@
 
 mod auto;
 mod body_sets;
+mod bounds;
 mod candidates;
 mod contacts;
 mod continuous;
@@ -18,13 +19,14 @@ use settings::{Integrator, StepSettings};
 
 use auto::{AutoMemory, IslandNeeds};
 use body_sets::{BodySets, EpochSeen};
+use bounds::BodyBounds;
 use candidates::{KeptPairs, NeighbourScratch};
 use continuous::Obstacles;
 use solver_bodies::GapTargets;
 use stats::StepStats;
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
-use crate::collide::reuse::{ManifoldCache, Pose};
+use crate::collide::reuse::ManifoldCache;
 use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon};
 use crate::math::Vec2;
 use crate::solver::contact::{Contact, restitution_threshold};
@@ -198,6 +200,8 @@ pub struct World {
     stats: StepStats,
     /// The ticks each stage of the last step took (`World::profile`).
     profile: StepProfile,
+    /// Each body's outline, pose, reach and bounds for the step.
+    bounds: BodyBounds,
     /// The broad phase's pairs, kept while they hold.
     kept_pairs: KeptPairs,
     /// The solvers, with what they keep from step to step: warm starts, factors, plans and
@@ -238,15 +242,6 @@ struct Scratch {
     wake_boxes: Vec<Option<Aabb>>,
     wake_reach: Vec<f64>,
     island_ready: Vec<bool>,
-    polygons: Vec<WorldPolygon>,
-    /// Per body: the place (`Body::place`) and pose its outline in `polygons` was made
-    /// at, and the outline's bounds (`find_candidate_pairs`).
-    outlined_at: Vec<Option<([u64; 3], Pose, Aabb)>>,
-    poses: Vec<Pose>,
-    boxes: Vec<Option<Aabb>>,
-    /// The sets' epoch, step length and contact margin (bits) that `boxes`, `reach`,
-    /// `motion` and `poses` of static and sleeping bodies were made with.
-    bounds_seen: Option<(u64, u64, u64)>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,
     /// Each body's bounding radius, and scratch for keeping a crowded body's nearest
@@ -259,11 +254,6 @@ struct Scratch {
     solver_bodies: Vec<SolverBody>,
     /// When the static and sleeping bodies of `solver_bodies` were copied.
     solver_bodies_seen: EpochSeen,
-    /// How far each body can move this step, and the two parts of it: its centroid's
-    /// displacement at its current velocity, and how far its spin can carry its
-    /// farthest point.
-    reach: Vec<f64>,
-    motion: Vec<(Vec2, f64)>,
     /// This step's manifolds' gaps less what their bodies can close of them, and how far
     /// a collision may turn each body off its course (`drop_idle_manifolds`).
     gaps: Vec<f64>,
@@ -940,7 +930,7 @@ mod tests {
     /// Every pair of bodies, not both fixed, whose bounds overlap now: what the broad
     /// phase must find, by comparing every pair.
     pub(super) fn overlapping_pairs(world: &World) -> Vec<(u32, u32)> {
-        let boxes = &world.scratch.boxes;
+        let boxes = &world.bounds.boxes;
         let n = boxes.len();
         let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
         (0..n)
