@@ -193,13 +193,13 @@ impl World {
         // whose bounds were not made again are as they were when last checked.
         let bounds = &self.bounds;
         let still_inside = kept.bounds.len() == n
-            && made.clone().all(|i| {
-                match (&bounds.boxes[i as usize], &kept.bounds[i as usize]) {
+            && made.clone().all(
+                |i| match (&bounds.boxes[i as usize], &kept.bounds[i as usize]) {
                     (Some(now), Some(fat)) => fat.contains(now),
                     (None, None) => true,
                     _ => false,
-                }
-            });
+                },
+            );
         let same_fixed = kept.fixed.len() == n
             && made.all(|i| kept.fixed[i as usize] == is_fixed(&self.bodies[i as usize]));
         let made_for = bounds.made_for().expect("made above");

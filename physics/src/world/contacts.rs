@@ -54,8 +54,12 @@ impl World {
         }
         for &(i, j) in &s.pairs {
             let (a, b) = (BodyHandle(i), BodyHandle(j));
-            let (pose_a, pose_b) = (&self.bounds.poses[i as usize], &self.bounds.poses[j as usize]);
-            let pair_margin = margin + self.bounds.reach[i as usize] + self.bounds.reach[j as usize];
+            let (pose_a, pose_b) = (
+                &self.bounds.poses[i as usize],
+                &self.bounds.poses[j as usize],
+            );
+            let pair_margin =
+                margin + self.bounds.reach[i as usize] + self.bounds.reach[j as usize];
             // A reused manifold is made in its place in the list (`reuse_into`).
             let limits = (pair_margin, reuse_tolerance);
             if self.settings.reuse_manifolds
@@ -74,7 +78,10 @@ impl World {
             // A pair that may move past the reuse tolerance in this step will not be reused
             // at the next one: the smash's debris found ~50,000 manifolds a step and reused
             // ~1,300.
-            let (motion_a, motion_b) = (self.bounds.motion[i as usize], self.bounds.motion[j as usize]);
+            let (motion_a, motion_b) = (
+                self.bounds.motion[i as usize],
+                self.bounds.motion[j as usize],
+            );
             if found
                 && self.settings.reuse_manifolds
                 && !relative_reach_exceeds(motion_a, motion_b, reuse_tolerance)
@@ -95,7 +102,7 @@ impl World {
                 a.friction.unwrap_or(self.friction),
                 b.friction.unwrap_or(self.friction),
             );
-            let start = &self.scratch.start_velocities;
+            let start = &self.inputs.start_velocities;
             let approach = |h: BodyHandle, body: &Body, point: Vec2| {
                 let (v, w) = start
                     .get(h.index())

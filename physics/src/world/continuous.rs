@@ -110,7 +110,7 @@ impl World {
         let s = &mut self.scratch;
         // The static bodies, looked at when the first body needs them (most steps, none
         // does), and listed again only if the sets changed.
-        let mut obstacles = std::mem::take(&mut s.obstacles);
+        let mut obstacles = std::mem::take(&mut self.obstacles);
         let mut listed = false;
         s.impacts.clear();
         for &i in self.sets.awake() {
@@ -215,7 +215,7 @@ impl World {
                 s.impacts.push((i as u32, t));
             }
         }
-        s.obstacles = obstacles;
+        self.obstacles = obstacles;
         self.move_back_to_impacts();
     }
 

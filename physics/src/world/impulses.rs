@@ -139,7 +139,7 @@ impl World {
         pass(
             &mut self.solvers.joints,
             &mut s.joint_constraints,
-            &mut s.solver_bodies,
+            &mut self.inputs.bodies,
             &it,
         );
         self.scatter_solver_bodies();
@@ -188,7 +188,7 @@ impl World {
                 self.solvers.exact.reports.clear();
                 solve_sequential(
                     &mut self.contacts,
-                    &mut s.solver_bodies,
+                    &mut self.inputs.bodies,
                     dt,
                     targets.bounce_below,
                 )
@@ -205,7 +205,7 @@ impl World {
                     model,
                     &mut self.contacts,
                     &mut s.joint_constraints,
-                    &mut s.solver_bodies,
+                    &mut self.inputs.bodies,
                     &targets,
                 );
             }
@@ -214,7 +214,7 @@ impl World {
             let it = self.settings.joint_iterations(dt);
             self.solvers.joints.correct_positions(
                 &mut s.joint_constraints,
-                &mut s.solver_bodies,
+                &mut self.inputs.bodies,
                 dt,
                 &it,
                 method.solves_motors_with_contacts(),
@@ -225,7 +225,7 @@ impl World {
             self.solvers.exact.separate(
                 &self.contacts,
                 &s.joint_constraints,
-                &mut s.solver_bodies,
+                &mut self.inputs.bodies,
                 dt,
                 self.settings.slop(),
                 SPLIT_IMPULSE_RATE,

@@ -20,12 +20,12 @@ impl World {
     /// (Every body's velocity is kept in `start_velocities` first, for restitution: the
     /// awake bodies' each time, the others' when the sets change.)
     pub(super) fn integrate_velocities(&mut self, dt: f64) {
-        let s = &mut self.scratch;
         let velocity = |b: &Body| (b.velocity, b.angular_velocity);
-        let changed = s.start_velocities_seen.sets_changed(&self.sets);
-        if changed || s.start_velocities.len() != self.bodies.len() {
-            s.start_velocities.clear();
-            s.start_velocities.extend(
+        let inputs = &mut self.inputs;
+        let changed = inputs.start_velocities_made.sets_changed(&self.sets);
+        if changed || inputs.start_velocities.len() != self.bodies.len() {
+            inputs.start_velocities.clear();
+            inputs.start_velocities.extend(
                 self.bodies
                     .iter()
                     .map(|b| b.as_ref().map_or((Vec2::zeros(), 0.0), velocity)),
@@ -33,7 +33,7 @@ impl World {
         } else {
             for &i in self.sets.awake() {
                 let b = self.bodies[i as usize].as_ref().expect("an awake body");
-                s.start_velocities[i as usize] = velocity(b);
+                inputs.start_velocities[i as usize] = velocity(b);
             }
         }
         for &i in self.sets.awake() {
@@ -76,7 +76,7 @@ impl World {
             b.force = Vec2::zeros();
             b.torque = 0.0;
         };
-        if self.scratch.forces_seen.sets_changed(&self.sets) {
+        if self.forces_cleared.sets_changed(&self.sets) {
             self.bodies.iter_mut().flatten().for_each(clear);
         } else {
             for &i in self.sets.awake() {

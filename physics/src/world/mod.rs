@@ -22,7 +22,7 @@ use body_sets::{BodySets, EpochSeen};
 use bounds::BodyBounds;
 use candidates::{KeptPairs, NeighbourScratch};
 use continuous::Obstacles;
-use solver_bodies::GapTargets;
+use solver_bodies::{GapTargets, SolverInputs};
 use stats::StepStats;
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
@@ -36,7 +36,7 @@ use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
 use crate::solver::soft::{SoftSettings, SoftStepSolver};
 use crate::solver::system::VelocityTargets;
-use crate::solver::{ImpulseMethod, SolverBody, StageList};
+use crate::solver::{ImpulseMethod, StageList};
 use crate::stage_clock::{self, Stage, StepProfile};
 
 /// A joint to be made: the bodies and the shared world point they pin together, given
@@ -202,6 +202,13 @@ pub struct World {
     profile: StepProfile,
     /// Each body's outline, pose, reach and bounds for the step.
     bounds: BodyBounds,
+    /// The bodies as the solvers take them, with their accelerations and the velocities
+    /// the step started with.
+    inputs: SolverInputs,
+    /// The static bodies as continuous collision's obstacles.
+    obstacles: Obstacles,
+    /// When every body's forces were last cleared (`clear_forces`).
+    forces_cleared: EpochSeen,
     /// The broad phase's pairs, kept while they hold.
     kept_pairs: KeptPairs,
     /// The solvers, with what they keep from step to step: warm starts, factors, plans and
@@ -251,23 +258,13 @@ struct Scratch {
     neighbours: NeighbourScratch,
     /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
     fixed_now: Vec<bool>,
-    solver_bodies: Vec<SolverBody>,
-    /// When the static and sleeping bodies of `solver_bodies` were copied.
-    solver_bodies_seen: EpochSeen,
     /// This step's manifolds' gaps less what their bodies can close of them, and how far
     /// a collision may turn each body off its course (`drop_idle_manifolds`).
     gaps: Vec<f64>,
     turn_off: Vec<f64>,
-    /// Velocities before this step's forces, for restitution, and when those of the
-    /// static and sleeping bodies were taken.
-    start_velocities: Vec<(Vec2, f64)>,
-    start_velocities_seen: EpochSeen,
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
     joint_constraints: Vec<JointConstraint>,
-    accelerations: Vec<(Vec2, f64)>,
-    /// When `accelerations` of static and sleeping bodies were set.
-    accelerations_seen: EpochSeen,
     /// By slot, each awake body's centroid and angle when the step began, for continuous
     /// collision.
     step_start: Vec<(Vec2, f64)>,
@@ -276,11 +273,8 @@ struct Scratch {
     mover_at_end: WorldPolygon,
     mover_at_start: WorldPolygon,
     toi_scratch: WorldPolygon,
-    /// When every body's forces were last cleared (`clear_forces`).
-    forces_seen: EpochSeen,
-    /// Continuous collision: the static bodies as obstacles; the bodies stopped and their
-    /// times of impact; joint islands and each island's earliest impact.
-    obstacles: Obstacles,
+    /// Continuous collision: the bodies stopped and their times of impact; joint islands
+    /// and each island's earliest impact.
     impacts: Vec<(u32, f64)>,
     impact_union: UnionFind,
     island_impact: Vec<f64>,
@@ -697,21 +691,22 @@ impl World {
     /// The soft step has its own stage list: forces, contacts found once, then substeps
     /// that integrate and solve together (see `solver::soft`).
     fn step_soft(&mut self, dt: f64) {
-        self.scratch.start_velocities.clear(); // forces act inside the substeps
+        self.inputs.start_velocities.clear(); // forces act inside the substeps
         self.detect_contacts(dt, Pipeline::Soft);
         // The soft step pulls every pin closed its own way: no repair targets.
         self.gather_solver_bodies_with(GapTargets::None);
-        let s = &mut self.scratch;
         // Zero but for the bodies the step moves (the ground's, last, among the zeros).
-        let changed = s.accelerations_seen.sets_changed(&self.sets);
-        if changed || s.accelerations.len() != self.bodies.len() + 1 {
-            s.accelerations.clear();
-            s.accelerations
+        let inputs = &mut self.inputs;
+        let changed = inputs.accelerations_made.sets_changed(&self.sets);
+        if changed || inputs.accelerations.len() != self.bodies.len() + 1 {
+            inputs.accelerations.clear();
+            inputs
+                .accelerations
                 .resize(self.bodies.len() + 1, (Vec2::zeros(), 0.0));
         }
         for &i in self.sets.awake() {
             let b = self.bodies[i as usize].as_ref().expect("an awake body");
-            s.accelerations[i as usize] = if b.is_fixed() {
+            inputs.accelerations[i as usize] = if b.is_fixed() {
                 (Vec2::zeros(), 0.0) // held by `auto` for this pass
             } else {
                 (
@@ -725,7 +720,7 @@ impl World {
         // velocities at its start foretold (a pendulum speeding up through its pin) would
         // bounce in the soft step's own restitution, which shares the impulse: the step is
         // taken again with the impact pass bouncing those pairs too.
-        let bodies = &self.scratch.solver_bodies;
+        let bodies = &self.inputs.bodies;
         let moves = |i: u32| bodies[i as usize].moves();
         let may_bounce = self.settings.propagate_impacts
             && self
@@ -748,8 +743,8 @@ impl World {
                     alternating_sweeps: self.settings.soft_alternating_sweeps,
                     ..SoftSettings::for_length_scale(self.settings.length_scale)
                 },
-                &mut s.solver_bodies,
-                &s.accelerations,
+                &mut self.inputs.bodies,
+                &self.inputs.accelerations,
                 &mut self.contacts,
                 &mut s.joint_constraints,
                 dt,
@@ -772,7 +767,7 @@ impl World {
     /// met within the step, which the impact pass did not foresee.
     fn unforeseen_impacts(&self, dt: f64) -> Vec<(u32, u32)> {
         let bounce_below = restitution_threshold(self.gravity, dt);
-        let bodies = &self.scratch.solver_bodies;
+        let bodies = &self.inputs.bodies;
         let moves = |i: u32| bodies[i as usize].moves();
         let mut pairs: Vec<(u32, u32)> = self
             .contacts
@@ -799,7 +794,9 @@ impl World {
         // a pair meets this step also takes the step's forces (as `exact`'s do).
         for c in self.contacts.iter_mut() {
             let (a, b) = (c.body_a.index(), c.body_b.index());
-            let kick = (s.accelerations[a].0 - s.accelerations[b].0).dot(&c.normal) * dt;
+            let kick = (self.inputs.accelerations[a].0 - self.inputs.accelerations[b].0)
+                .dot(&c.normal)
+                * dt;
             c.normal_velocity = c.approach_velocity + kick;
             if c.depth < 0.0 && unforeseen.contains(&(c.body_a.0, c.body_b.0)) {
                 // Closing twice the gap within the step: the pair meets.
@@ -810,7 +807,7 @@ impl World {
         self.solvers.exact.propagate_all_impacts(
             &mut self.contacts,
             &s.joint_constraints,
-            &mut s.solver_bodies,
+            &mut self.inputs.bodies,
             &VelocityTargets {
                 dt,
                 bounce_below: restitution_threshold(self.gravity, dt),

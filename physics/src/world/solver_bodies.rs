@@ -2,6 +2,7 @@
 //! the solved velocities and poses copied back.
 
 use super::World;
+use super::body_sets::EpochSeen;
 use crate::body::BodyHandle;
 use crate::math::Vec2;
 use crate::solver::SolverBody;
@@ -16,6 +17,21 @@ pub(super) enum GapTargets {
     None,
 }
 
+/// The bodies as the solvers take them (by slot, the static world last), their
+/// accelerations for the soft step and their velocities at the step's start for
+/// restitution. The awake bodies' are made again for each pass; the static and sleeping
+/// bodies', which no solver moves, when the sets change (`*_made`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct SolverInputs {
+    pub(super) bodies: Vec<SolverBody>,
+    pub(super) bodies_made: EpochSeen,
+    pub(super) accelerations: Vec<(Vec2, f64)>,
+    pub(super) accelerations_made: EpochSeen,
+    /// Empty while the soft step runs (its forces act inside its substeps).
+    pub(super) start_velocities: Vec<(Vec2, f64)>,
+    pub(super) start_velocities_made: EpochSeen,
+}
+
 impl World {
     /// Copies the bodies into the solver array, the static world last, and resolves the
     /// joints to slots in it, each with the gap it is to close this step.
@@ -28,19 +44,20 @@ impl World {
         let ground = self.bodies.len() as u32;
         // Static and sleeping bodies are copied when the sets change; the solvers move
         // neither, so their copies stay as made.
-        let changed = s.solver_bodies_seen.sets_changed(&self.sets);
-        if changed || s.solver_bodies.len() != self.bodies.len() + 1 {
-            s.solver_bodies.clear();
-            s.solver_bodies.extend(
+        let inputs = &mut self.inputs;
+        let changed = inputs.bodies_made.sets_changed(&self.sets);
+        if changed || inputs.bodies.len() != self.bodies.len() + 1 {
+            inputs.bodies.clear();
+            inputs.bodies.extend(
                 self.bodies
                     .iter()
                     .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
             );
-            s.solver_bodies.push(SolverBody::default());
+            inputs.bodies.push(SolverBody::default());
         } else {
             for &i in self.sets.awake() {
                 let body = self.bodies[i as usize].as_ref().expect("an awake body");
-                s.solver_bodies[i as usize] = SolverBody::from_body(body);
+                inputs.bodies[i as usize] = SolverBody::from_body(body);
             }
         }
         s.joint_constraints.clear();
@@ -60,7 +77,7 @@ impl World {
                 gap_target: Vec2::zeros(),
             };
             if targets == GapTargets::ForBrokenJoints {
-                let gap_now = c.predicted_gap(&s.solver_bodies, 0.0);
+                let gap_now = c.predicted_gap(&inputs.bodies, 0.0);
                 let broken_gap = self.settings.joint_iterations(1.0).broken_gap;
                 c.gap_target = velocity_gap_target(gap_now, broken_gap);
             }
@@ -73,7 +90,7 @@ impl World {
     pub(super) fn scatter_solver_bodies(&mut self) {
         for &i in self.sets.awake() {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
-            let solved = &self.scratch.solver_bodies[i as usize];
+            let solved = &self.inputs.bodies[i as usize];
             b.velocity = solved.velocity;
             b.angular_velocity = solved.angular_velocity;
             b.position = solved.position;
