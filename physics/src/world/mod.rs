@@ -245,9 +245,11 @@ struct Scratch {
     island_union: UnionFind,
     wake_labels: Vec<u32>,
     wake_broad_phase: BroadPhase,
-    /// Waking's own bounding boxes and reaches (its broad phase's).
+    /// Waking's own bounding boxes and reaches by slot (its broad phase's), and the
+    /// slots boxed.
     wake_boxes: Vec<Option<Aabb>>,
     wake_reach: Vec<f64>,
+    wake_slots: Vec<u32>,
     island_ready: Vec<bool>,
     broad_phase: BroadPhase,
     pairs: Vec<(u32, u32)>,

@@ -49,27 +49,33 @@ impl World {
                     + self.gravity.norm() * dt)
                     * dt
             };
+            // Boxes for the bodies that can move, asleep or awake, by slot (the static
+            // ones take no part).
             let s = &mut self.scratch;
-            s.wake_boxes.clear();
-            s.wake_reach.clear();
-            for body in &self.bodies {
-                let r = body
+            let n = self.bodies.len();
+            s.wake_boxes.resize(n, None);
+            s.wake_reach.resize(n, 0.0);
+            s.wake_slots.clear();
+            s.wake_slots.extend_from_slice(self.sets.awake());
+            s.wake_slots.extend_from_slice(self.sets.sleeping());
+            s.wake_slots.sort_unstable();
+            for &i in &s.wake_slots {
+                let b = self.bodies[i as usize]
                     .as_ref()
-                    .map_or(0.0, |b| if b.asleep { 0.0 } else { reach(b) });
-                s.wake_reach.push(r);
-                s.wake_boxes
-                    .push(body.as_ref().filter(|b| !b.is_static()).map(|b| {
-                        let half = b.bounding_radius() + r + 0.5 * margin;
-                        Aabb {
-                            min: b.position - Vec2::new(half, half),
-                            max: b.position + Vec2::new(half, half),
-                        }
-                    }));
+                    .expect("a body that can move");
+                let r = if b.asleep { 0.0 } else { reach(b) };
+                let half = b.bounding_radius() + r + 0.5 * margin;
+                s.wake_reach[i as usize] = r;
+                s.wake_boxes[i as usize] = Some(Aabb {
+                    min: b.position - Vec2::new(half, half),
+                    max: b.position + Vec2::new(half, half),
+                });
             }
             let bodies = &self.bodies;
             let asleep = |i: usize| bodies[i].as_ref().is_some_and(|b| b.asleep);
+            let wanted = |i, j| asleep(i) != asleep(j);
             s.wake_broad_phase
-                .pairs(&s.wake_boxes, |i, j| asleep(i) != asleep(j), &mut s.pairs);
+                .pairs_among(&s.wake_boxes, &s.wake_slots, wanted, &mut s.pairs);
             for &(i, j) in &s.pairs {
                 let (sleeper, awake) = if asleep(i as usize) { (i, j) } else { (j, i) };
                 let (b, a) = (
@@ -110,10 +116,8 @@ impl World {
     /// bodies have all been still long enough.
     pub(super) fn sleep_where_still(&mut self, dt: f64) {
         let tolerance = self.settings.sleep_speed();
-        for b in self.bodies.iter_mut().flatten() {
-            if b.is_fixed() {
-                continue;
-            }
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_mut().expect("an awake body");
             let speed = b.velocity.norm() + b.angular_velocity.abs() * b.bounding_radius();
             b.still_time = if speed < tolerance {
                 b.still_time + dt
@@ -145,11 +149,9 @@ impl World {
         let mut ready = std::mem::take(&mut self.scratch.island_ready);
         ready.clear();
         ready.resize(n, true);
-        for i in 0..n as u32 {
-            if let Some(b) = self.bodies[i as usize].as_ref()
-                && !b.is_fixed()
-                && b.still_time < SLEEP_AFTER
-            {
+        for &i in self.sets.awake() {
+            let b = self.bodies[i as usize].as_ref().expect("an awake body");
+            if b.still_time < SLEEP_AFTER {
                 ready[uf.find(i) as usize] = false;
             }
         }
@@ -168,16 +170,18 @@ impl World {
             }
         }
         self.sleep_labels.resize(n, u32::MAX);
-        for i in 0..n as u32 {
+        let mut some_fell_asleep = false;
+        for &i in self.sets.awake() {
             let root = uf.find(i);
-            if let Some(b) = self.bodies[i as usize].as_mut()
-                && !b.is_fixed()
-                && ready[root as usize]
-            {
+            if ready[root as usize] {
+                let b = self.bodies[i as usize].as_mut().expect("an awake body");
                 b.fall_asleep();
                 self.sleep_labels[i as usize] = root;
-                self.sets.mark_changed();
+                some_fell_asleep = true;
             }
+        }
+        if some_fell_asleep {
+            self.sets.mark_changed();
         }
         self.scratch.island_ready = ready;
     }
