@@ -124,15 +124,19 @@ fn centre(world: &mut World, body: BodyId) -> (f64, f64) {
 /// The static floor, its top face at height `top`, restitution 0 (the pair takes the
 /// larger).
 fn floor(w: &mut World, top: f64) {
-    let body = body_at(BodyType::Static, (0.0, top - 0.5 * FLOOR.1));
-    boxed(w, body, FLOOR, 0.0, 0.0);
+    floor_piece(w, (0.0, top - 0.5 * FLOOR.1), FLOOR);
+}
+
+/// A static box of the floor.
+fn floor_piece(w: &mut World, centre: (f64, f64), size: (f64, f64)) {
+    boxed(w, body_at(BodyType::Static, centre), size, 0.0, 0.0);
 }
 
 /// A pyramid (or stack) stepped at `h` for `spec.steps`.
 pub fn pyramid(spec: &Pyramid, h: f64, substeps: i32) -> Outcome {
     let mut w = world();
-    for top in spec.floor_tops() {
-        floor(&mut w, top);
+    for (centre, size) in spec.floor_pieces() {
+        floor_piece(&mut w, centre, size);
     }
     let centres = spec.centres();
     let boxes: Vec<BodyId> = centres

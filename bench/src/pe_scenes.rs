@@ -78,20 +78,25 @@ fn rectangle(w: f64, h: f64) -> ConvexPolygon {
     ConvexPolygon::rectangle(w, h).expect("positive sizes")
 }
 
-/// The static floor, its top face at height `top`. Restitution 1 because pe combines a
-/// pair's restitutions by their minimum: the moving body's own value then applies.
+/// The static floor, its top face at height `top`.
 fn floor(w: &mut World, top: f64) {
-    let def = BodyDef::new(rectangle(FLOOR.0, FLOOR.1), 0.0)
+    floor_piece(w, (0.0, top - 0.5 * FLOOR.1), FLOOR);
+}
+
+/// A static box of the floor. Restitution 1 because pe combines a pair's restitutions by
+/// their minimum: the moving body's own value then applies.
+fn floor_piece(w: &mut World, centre: (f64, f64), size: (f64, f64)) {
+    let def = BodyDef::new(rectangle(size.0, size.1), 0.0)
         .restitution(1.0)
-        .at(at((0.0, top - 0.5 * FLOOR.1)), 0.0);
+        .at(at(centre), 0.0);
     w.add_body(def).expect("valid floor");
 }
 
 /// A pyramid (or stack) stepped at `h` for `spec.steps`.
 pub fn pyramid(config: PeConfig, spec: &Pyramid, h: f64) -> Outcome {
     let mut w = world(config);
-    for top in spec.floor_tops() {
-        floor(&mut w, top);
+    for (centre, size) in spec.floor_pieces() {
+        floor_piece(&mut w, centre, size);
     }
     let unit = rectangle(BOX, BOX);
     let centres = spec.centres();

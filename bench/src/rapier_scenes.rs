@@ -96,10 +96,15 @@ fn cuboid(w: f64, h: f64, density: f64) -> ColliderBuilder {
 /// The static floor, its top face at height `top`, with the scenes' friction so that
 /// rapier's default averaging of the pair's coefficients gives exactly `FRICTION`.
 fn floor(w: &mut PhysicsWorld, top: f64, restitution: f64) {
+    floor_piece(w, (0.0, top - 0.5 * FLOOR.1), FLOOR, restitution);
+}
+
+/// A static box of the floor.
+fn floor_piece(w: &mut PhysicsWorld, centre: (f64, f64), size: (f64, f64), restitution: f64) {
     let body = RigidBodyBuilder::fixed()
-        .translation(point((0.0, top - 0.5 * FLOOR.1)))
+        .translation(point(centre))
         .can_sleep(false);
-    let shape = cuboid(FLOOR.0, FLOOR.1, 0.0)
+    let shape = cuboid(size.0, size.1, 0.0)
         .friction(FRICTION as Real)
         .restitution(restitution as Real);
     w.insert(body, shape);
@@ -108,8 +113,8 @@ fn floor(w: &mut PhysicsWorld, top: f64, restitution: f64) {
 /// A pyramid (or stack) stepped at `h` for `spec.steps`.
 pub fn pyramid(spec: &Pyramid, h: f64, iterations: usize) -> Outcome {
     let mut w = world(h, iterations);
-    for top in spec.floor_tops() {
-        floor(&mut w, top, 0.0);
+    for (centre, size) in spec.floor_pieces() {
+        floor_piece(&mut w, centre, size, 0.0);
     }
     let centres = spec.centres();
     let boxes: Vec<RigidBodyHandle> = centres

@@ -67,7 +67,8 @@ pub fn worst(so_far: f64, sample: f64) -> f64 {
 
 /// A pyramid of unit boxes, `rows` at the base, standing on the floor; or a grid of them,
 /// `grid.0` side by side on each of `grid.1` floors stacked one above the other. With
-/// `stack`, a column of `rows` boxes instead.
+/// `stack`, a column of `rows` boxes instead. With `tiles`, each floor is that many
+/// static unit tiles side by side (a terrain of many pieces) instead of one slab.
 #[derive(Debug, Clone, Copy)]
 pub struct Pyramid {
     pub name: &'static str,
@@ -75,15 +76,17 @@ pub struct Pyramid {
     pub steps: usize,
     pub grid: (usize, usize),
     pub stack: bool,
+    pub tiles: usize,
 }
 
-pub const PYRAMIDS: [Pyramid; 4] = [
+pub const PYRAMIDS: [Pyramid; 5] = [
     Pyramid {
         name: "pyramid20",
         rows: 20,
         steps: 600,
         grid: (1, 1),
         stack: false,
+        tiles: 0,
     },
     // 820 boxes: 300 steps (5 s) keep the whole benchmark within a few minutes.
     Pyramid {
@@ -92,6 +95,7 @@ pub const PYRAMIDS: [Pyramid; 4] = [
         steps: 300,
         grid: (1, 1),
         stack: false,
+        tiles: 0,
     },
     // Box2D's large_pyramid benchmark: base 100, 5,050 boxes, 500 steps.
     Pyramid {
@@ -100,6 +104,7 @@ pub const PYRAMIDS: [Pyramid; 4] = [
         steps: 500,
         grid: (1, 1),
         stack: false,
+        tiles: 0,
     },
     // After Box2D's many_pyramids: many small islands instead of one big one. 10 × 10
     // pyramids of base 10 (5,500 boxes, as many as large_pyramid), ten to a floor.
@@ -109,6 +114,17 @@ pub const PYRAMIDS: [Pyramid; 4] = [
         steps: 300,
         grid: (10, 10),
         stack: false,
+        tiles: 0,
+    },
+    // pyramid20 on a floor of 2,000 static unit tiles (a terrain of many pieces): what
+    // bodies that never move cost each engine.
+    Pyramid {
+        name: "pyramid20_on_tiles",
+        rows: 20,
+        steps: 600,
+        grid: (1, 1),
+        stack: false,
+        tiles: 2000,
     },
 ];
 
@@ -120,6 +136,7 @@ pub const STACKS: [Pyramid; 2] = [
         steps: 600,
         grid: (1, 1),
         stack: true,
+        tiles: 0,
     },
     Pyramid {
         name: "stack20",
@@ -127,6 +144,7 @@ pub const STACKS: [Pyramid; 2] = [
         steps: 600,
         grid: (1, 1),
         stack: true,
+        tiles: 0,
     },
 ];
 
@@ -151,6 +169,24 @@ impl Pyramid {
             }
         }
         centres
+    }
+
+    /// Each floor's pieces as (centre, size): one slab of `FLOOR`, or `tiles` unit tiles
+    /// side by side, centred, their seams under the boxes' (a box on one tile each).
+    pub fn floor_pieces(&self) -> Vec<((f64, f64), (f64, f64))> {
+        let mut pieces = Vec::new();
+        for top in self.floor_tops() {
+            if self.tiles == 0 {
+                pieces.push(((0.0, top - 0.5 * FLOOR.1), FLOOR));
+                continue;
+            }
+            let left = -0.5 * self.tiles as f64 * BOX;
+            for k in 0..self.tiles {
+                let x = left + (k as f64 + 0.5) * BOX;
+                pieces.push(((x, top - 0.5 * BOX), (BOX, BOX)));
+            }
+        }
+        pieces
     }
 
     /// The height of each floor's top face: the first at 0, the next a box above the
