@@ -16,8 +16,8 @@ pub(super) struct BodySets {
     statics: Vec<u32>,
     sleeping: Vec<u32>,
     awake: Vec<u32>,
-    /// Counts the changes outside the awake set; starts at 1 once a body is added, so that
-    /// a stage that has seen nothing (0) refreshes everything.
+    /// Counts the changes outside the awake set: a stage that made its results at another
+    /// count makes them again for every body.
     epoch: u64,
     /// The lists are to be sorted again from the bodies before they are next read.
     stale: bool,

@@ -130,7 +130,7 @@ pub(super) struct KeptPairs {
     /// the pairs.
     crowded: bool,
     /// The static and sleeping bodies in cells of their own, and the bounds they were
-    /// listed with (`bounds_seen`'s key and the growth, in bits); the fixed bodies, as
+    /// listed with (`BodyBounds::made_for` and the growth, in bits); the fixed bodies, as
     /// scratch.
     fixed_cells: FixedCells,
     fixed_cells_for: Option<((u64, u64, u64), u64)>,

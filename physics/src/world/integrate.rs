@@ -6,12 +6,16 @@ use crate::body::Body;
 use crate::math::Vec2;
 
 impl World {
-    /// Stage 2: body motors add their torque (SPEC §4.4).
+    /// Stage 2: body motors add their torque (SPEC §4.4), to the bodies the step moves
+    /// only: a static or sleeping body's forces are not cleared after the step.
     pub(super) fn apply_motor_torques(&mut self, dt: f64) {
         for (handle, motor) in self.body_motors.iter_mut() {
             let Some(Some(b)) = self.bodies.get_mut(handle.index()) else {
                 continue;
             };
+            if b.is_static() || b.is_asleep() {
+                continue;
+            }
             b.torque += motor.torque(self.step_count, b.angular_velocity, dt);
         }
     }
