@@ -89,3 +89,42 @@ impl World {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::BodyDef;
+    use crate::shape::ConvexPolygon;
+    use crate::solver::motor::BodyMotor;
+
+    /// Forces and torques last one step on every body: a box asleep on a static floor,
+    /// both given a force and a torque by hand, and a motor running on the floor (which
+    /// does not turn it). After the next step no body holds any.
+    #[test]
+    fn forces_last_one_step_on_every_body() {
+        let mut world = World::new(Vec2::new(0.0, 10.0));
+        world.settings.sleeping = true;
+        let slab = ConvexPolygon::rectangle(10.0, 1.0).unwrap();
+        let floor = world.add_body(BodyDef::new(slab, 0.0)).unwrap();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        let at = Vec2::new(0.0, -1.0);
+        let square = world.add_body(BodyDef::new(unit, 1.0).at(at, 0.0)).unwrap();
+        for _ in 0..120 {
+            world.step(1.0 / 60.0);
+        }
+        assert!(world.body(square).unwrap().is_asleep());
+        let motor = BodyMotor::new(0, 1000, 1.0, 10.0, 20.0, 0.1);
+        world.add_body_motor(floor, motor).unwrap();
+        for handle in [floor, square] {
+            let body = world.body_mut(handle).unwrap();
+            body.force = Vec2::new(1.0, 2.0);
+            body.torque = 3.0;
+        }
+        for step in 0..3 {
+            world.step(1.0 / 60.0);
+            for (_, b) in world.bodies() {
+                assert_eq!((b.force, b.torque), (Vec2::zeros(), 0.0), "step {step}");
+            }
+        }
+    }
+}
