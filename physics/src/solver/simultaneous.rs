@@ -4,7 +4,7 @@
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
-use super::island::{IslandGrouping, slots_that_move};
+use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
@@ -75,8 +75,6 @@ pub(crate) struct SimultaneousSolver {
     /// The contacts' and joints' islands, kept while the items and the moving bodies are
     /// the same (the passes of one substep find them once).
     grouping: IslandGrouping,
-    /// The bodies that move, for the grouping.
-    moving: Vec<u32>,
     /// Each island's span of `grouped`.
     ranges: Vec<(usize, usize)>,
     contact_count: usize,
@@ -150,20 +148,27 @@ const IMPACT_SOLVES_PER_PAIR: usize = 8;
 impl SimultaneousSolver {
     /// Solves every island and applies the impulses to `bodies`; contacts get their normal
     /// and tangent impulses, joints with motors their motor impulse. With `TwoStage`,
-    /// joints are left to the joint passes, as in the thesis.
+    /// joints are left to the joint passes, as in the thesis. `moving`: the slots of the
+    /// bodies that move, increasing (every other body of `bodies` is fixed).
     pub(crate) fn solve(
         &mut self,
         model: FrictionModel,
         contacts: &mut [Contact],
         joints: &mut [JointConstraint],
-        bodies: &mut [SolverBody],
+        (bodies, moving): (&mut [SolverBody], &[u32]),
         targets: &VelocityTargets,
     ) {
         self.reports.clear();
         self.over_budget_bodies.clear();
         self.regularisation = REGULARISATION;
         self.memory.recall(contacts, &mut self.recalled);
-        self.group(contacts, joints, model == FrictionModel::Coupled, bodies);
+        self.group(
+            contacts,
+            joints,
+            model == FrictionModel::Coupled,
+            bodies,
+            moving,
+        );
         for island in 0..self.ranges.len() {
             self.load_island(island, contacts, joints);
             self.impact_impulses.clear();
@@ -188,7 +193,7 @@ impl SimultaneousSolver {
         &mut self,
         contacts: &mut [Contact],
         joints: &[JointConstraint],
-        bodies: &mut [SolverBody],
+        (bodies, moving): (&mut [SolverBody], &[u32]),
         targets: &VelocityTargets,
     ) {
         // As in `propagate_impacts`: and the soft step's own bounce off a fixed body places
@@ -196,7 +201,7 @@ impl SimultaneousSolver {
         if !contacts.iter().any(|c| passes_on(c, bodies, targets)) {
             return;
         }
-        self.group(contacts, joints, true, bodies);
+        self.group(contacts, joints, true, bodies, moving);
         for island in 0..self.ranges.len() {
             self.load_island(island, contacts, joints);
             if !self
@@ -252,7 +257,7 @@ impl SimultaneousSolver {
         &mut self,
         contacts: &[Contact],
         joints: &[JointConstraint],
-        bodies: &mut [SolverBody],
+        (bodies, moving): (&mut [SolverBody], &[u32]),
         dt: f64,
         slop: f64,
         rate: f64,
@@ -263,14 +268,31 @@ impl SimultaneousSolver {
         let mut joints_copy = std::mem::take(&mut self.scratch_joints);
         joints_copy.clear();
         joints_copy.extend_from_slice(joints);
-        self.group(&contacts_copy, &joints_copy, true, bodies);
+        self.group(&contacts_copy, &joints_copy, true, bodies, moving);
         let mut pseudo = std::mem::take(&mut self.pseudo);
-        pseudo.clear();
-        pseudo.extend(bodies.iter().map(|b| SolverBody {
+        let at_rest = |b: &SolverBody| SolverBody {
             velocity: crate::math::Vec2::zeros(),
             angular_velocity: 0.0,
             ..*b
-        }));
+        };
+        let ends = 2 * (contacts_copy.len() + joints_copy.len()) + moving.len();
+        if pseudo.len() == bodies.len() && ends < bodies.len() {
+            // Only the bodies the rows read (the contacts' and joints') and the moving ones,
+            // which the pass moves: a terrain's 2,000 tiles are not copied at every step.
+            // (The same numbers as copying them all, which a robot's few bodies take.)
+            let contact_ends = contacts_copy.iter().map(|c| (c.body_a.0, c.body_b.0));
+            let joint_ends = joints_copy.iter().map(|j| (j.body_a, j.body_b));
+            for (a, b) in contact_ends.chain(joint_ends) {
+                pseudo[a as usize] = at_rest(&bodies[a as usize]);
+                pseudo[b as usize] = at_rest(&bodies[b as usize]);
+            }
+            for &i in moving {
+                pseudo[i as usize] = at_rest(&bodies[i as usize]);
+            }
+        } else {
+            pseudo.clear();
+            pseudo.extend(bodies.iter().map(at_rest));
+        }
         let targets = VelocityTargets {
             dt,
             bounce_below: f64::INFINITY,
@@ -301,7 +323,9 @@ impl SimultaneousSolver {
             self.solve_rows(&mut pseudo, true);
             self.limit_separation(&mut pseudo, dt, slop);
         }
-        for (body, p) in bodies.iter_mut().zip(&pseudo) {
+        // Only the moving bodies have a pseudo-velocity.
+        for &i in moving {
+            let (body, p) = (&mut bodies[i as usize], &pseudo[i as usize]);
             body.position += p.velocity * dt;
             body.angle += p.angular_velocity * dt;
         }
@@ -345,6 +369,7 @@ impl SimultaneousSolver {
         joints: &[JointConstraint],
         with_joints: bool,
         bodies: &[SolverBody],
+        moving: &[u32],
     ) {
         let nc = contacts.len();
         let joint_count = if with_joints { joints.len() } else { 0 };
@@ -355,10 +380,9 @@ impl SimultaneousSolver {
                 (joints[i - nc].body_a, joints[i - nc].body_b)
             }
         };
-        slots_that_move(bodies, SolverBody::moves, &mut self.moving);
         let grouped = self
             .grouping
-            .group(nc + joint_count, bodies.len(), ends, &self.moving);
+            .group(nc + joint_count, bodies.len(), ends, moving);
         self.contact_count = nc;
         self.ranges.clear();
         let mut start = 0;

@@ -205,7 +205,7 @@ impl World {
                     model,
                     &mut self.contacts,
                     &mut s.joint_constraints,
-                    &mut self.inputs.bodies,
+                    self.inputs.bodies_and_moving(self.sets.awake()),
                     &targets,
                 );
             }
@@ -225,7 +225,7 @@ impl World {
             self.solvers.exact.separate(
                 &self.contacts,
                 &s.joint_constraints,
-                &mut self.inputs.bodies,
+                self.inputs.bodies_and_moving(self.sets.awake()),
                 dt,
                 self.settings.slop(),
                 SPLIT_IMPULSE_RATE,

@@ -809,7 +809,7 @@ impl World {
         self.solvers.exact.propagate_all_impacts(
             &mut self.contacts,
             &s.joint_constraints,
-            &mut self.inputs.bodies,
+            self.inputs.bodies_and_moving(self.sets.awake()),
             &VelocityTargets {
                 dt,
                 bounce_below: restitution_threshold(self.gravity, dt),

@@ -25,11 +25,29 @@ pub(super) enum GapTargets {
 pub(super) struct SolverInputs {
     pub(super) bodies: Vec<SolverBody>,
     pub(super) bodies_made: EpochSeen,
+    /// The slots of the bodies that move (awake and not held by `auto`), increasing, as
+    /// `bodies_and_moving` last found them.
+    moving: Vec<u32>,
     pub(super) accelerations: Vec<(Vec2, f64)>,
     pub(super) accelerations_made: EpochSeen,
     /// Empty while the soft step runs (its forces act inside its substeps).
     pub(super) start_velocities: Vec<(Vec2, f64)>,
     pub(super) start_velocities_made: EpochSeen,
+}
+
+impl SolverInputs {
+    /// The bodies, and the slots of those that move: the `awake` ones not held.
+    pub(super) fn bodies_and_moving(&mut self, awake: &[u32]) -> (&mut [SolverBody], &[u32]) {
+        let bodies = &self.bodies;
+        self.moving.clear();
+        self.moving.extend(
+            awake
+                .iter()
+                .copied()
+                .filter(|&i| bodies[i as usize].moves()),
+        );
+        (&mut self.bodies, &self.moving)
+    }
 }
 
 impl World {
