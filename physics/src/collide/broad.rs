@@ -277,7 +277,7 @@ impl BroadPhase {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::math::Vec2;
 
@@ -289,7 +289,7 @@ mod tests {
     }
 
     /// A deterministic stream of numbers in [0, 1) (xorshift).
-    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    pub(in crate::collide) fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
         move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;

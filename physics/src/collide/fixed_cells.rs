@@ -135,6 +135,7 @@ impl FixedCells {
 
 #[cfg(test)]
 mod tests {
+    use super::super::broad::tests::uniform;
     use super::*;
     use crate::math::Vec2;
 
@@ -143,13 +144,7 @@ mod tests {
     /// are exactly those of comparing every moving body with every fixed one.
     #[test]
     fn finds_exactly_the_overlapping_pairs_of_moving_and_fixed_bodies() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(0x9e37_79b9_7f4a_7c15);
         for offset in [0.0, -53.1, 1e7] {
             let boxes: Vec<Option<Aabb>> = (0..400)
                 .map(|i| {

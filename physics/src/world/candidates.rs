@@ -296,7 +296,7 @@ impl World {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::overlapping_pairs;
+    use super::super::tests::{overlapping_pairs, pairs_overlapping};
     use super::*;
     use crate::body::BodyDef;
     use crate::math::Vec2;
@@ -421,17 +421,7 @@ mod tests {
                 Some(aabb.grown(0.5 * margin + reach))
             })
             .collect();
-        let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
-        let n = bounds.len();
-        (0..n)
-            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-            .filter(|&(i, j)| !(fixed(i) && fixed(j)))
-            .filter(|&(i, j)| match (&bounds[i], &bounds[j]) {
-                (Some(a), Some(b)) => a.overlaps(b),
-                _ => false,
-            })
-            .map(|(i, j)| (i as u32, j as u32))
-            .collect()
+        pairs_overlapping(world, &bounds)
     }
 
     /// The step looks again only at the awake bodies; the others' bounds are kept until

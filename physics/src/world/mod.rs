@@ -929,7 +929,11 @@ mod tests {
     /// Every pair of bodies, not both fixed, whose bounds overlap now: what the broad
     /// phase must find, by comparing every pair.
     pub(super) fn overlapping_pairs(world: &World) -> Vec<(u32, u32)> {
-        let boxes = &world.bounds.boxes;
+        pairs_overlapping(world, &world.bounds.boxes)
+    }
+
+    /// The pairs of `boxes` (by slot) that overlap, but for pairs of two fixed bodies.
+    pub(super) fn pairs_overlapping(world: &World, boxes: &[Option<Aabb>]) -> Vec<(u32, u32)> {
         let n = boxes.len();
         let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
         (0..n)
