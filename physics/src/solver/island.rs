@@ -182,12 +182,6 @@ impl IslandGrouping {
     }
 }
 
-/// The slots of `bodies` that `moves`, increasing, into `out`.
-pub(crate) fn slots_that_move<B>(bodies: &[B], moves: impl Fn(&B) -> bool, out: &mut Vec<u32>) {
-    out.clear();
-    out.extend((0..bodies.len() as u32).filter(|&i| moves(&bodies[i as usize])));
-}
-
 /// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
 /// is scratch, kept by the caller so that a step allocates nothing.
 pub(crate) fn counting_sort<T: Copy>(

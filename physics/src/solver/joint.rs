@@ -1,7 +1,7 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
 use super::SolverBody;
-use super::island::{IslandGrouping, slots_that_move};
+use super::island::IslandGrouping;
 use super::pin_island::{PinIsland, displace_island};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
@@ -314,8 +314,6 @@ struct JointIslands {
     /// The joints' islands, kept while the joints and the moving bodies are the same (a
     /// chain's are found once, not at every pass of every substep).
     grouping: IslandGrouping,
-    /// The bodies that move, for the grouping.
-    moving: Vec<u32>,
     island: Vec<JointConstraint>,
 }
 
@@ -425,19 +423,19 @@ fn island_bodies(joints: &[JointConstraint]) -> impl Iterator<Item = usize> + '_
 }
 
 impl JointIslands {
-    /// Calls `solve` once per island with that island's joints, copied contiguously.
+    /// Calls `solve` once per island with that island's joints, copied contiguously;
+    /// `moving`: the slots of the bodies that move, increasing.
     fn for_each(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: &mut [SolverBody],
+        (bodies, moving): (&mut [SolverBody], &[u32]),
         mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
     ) {
-        slots_that_move(bodies, SolverBody::moves, &mut self.moving);
         let grouped = self.grouping.group(
             joints.len(),
             bodies.len(),
             |i| (joints[i].body_a, joints[i].body_b),
-            &self.moving,
+            moving,
         );
         let mut start = 0;
         while start < grouped.len() {
@@ -467,7 +465,7 @@ impl JointBlockSolver {
     pub(crate) fn repair_positions(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: &mut [SolverBody],
+        (bodies, moving): (&mut [SolverBody], &[u32]),
         it: &JointIterations,
     ) {
         if joints
@@ -477,29 +475,30 @@ impl JointBlockSolver {
             return;
         }
         let pin_island = &mut self.pin_island;
-        self.islands.for_each(joints, bodies, |island, bodies| {
-            let mut slots: Vec<usize> = island_bodies(island).collect();
-            slots.sort_unstable();
-            slots.dedup();
-            for &i in &slots {
-                bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
-            }
-            let direct = island.len() <= DIRECT_JOINT_LIMIT;
-            let targets = || with_repair_targets(island, bodies, it);
-            if !(direct && pin_island.repair(&targets(), bodies, it)) {
-                repair_positions_sequential(island, bodies, it);
-            }
-            for &i in &slots {
-                bodies[i].inv_inertia /= REPAIR_ROTATION_WEIGHT;
-            }
-        });
+        self.islands
+            .for_each(joints, (bodies, moving), |island, bodies| {
+                let mut slots: Vec<usize> = island_bodies(island).collect();
+                slots.sort_unstable();
+                slots.dedup();
+                for &i in &slots {
+                    bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
+                }
+                let direct = island.len() <= DIRECT_JOINT_LIMIT;
+                let targets = || with_repair_targets(island, bodies, it);
+                if !(direct && pin_island.repair(&targets(), bodies, it)) {
+                    repair_positions_sequential(island, bodies, it);
+                }
+                for &i in &slots {
+                    bodies[i].inv_inertia /= REPAIR_ROTATION_WEIGHT;
+                }
+            });
     }
 
     /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
     pub(crate) fn correct_velocities(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: &mut [SolverBody],
+        bodies: (&mut [SolverBody], &[u32]),
         it: &JointIterations,
     ) {
         let pin_island = &mut self.pin_island;
@@ -518,7 +517,7 @@ impl JointBlockSolver {
     pub(crate) fn correct_positions(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: &mut [SolverBody],
+        bodies: (&mut [SolverBody], &[u32]),
         dt: f64,
         it: &JointIterations,
         motors_started: bool,

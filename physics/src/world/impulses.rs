@@ -126,7 +126,7 @@ impl World {
         pass: fn(
             &mut JointBlockSolver,
             &mut [JointConstraint],
-            &mut [SolverBody],
+            (&mut [SolverBody], &[u32]),
             &JointIterations,
         ),
     ) {
@@ -139,7 +139,7 @@ impl World {
         pass(
             &mut self.solvers.joints,
             &mut s.joint_constraints,
-            &mut self.inputs.bodies,
+            self.inputs.bodies_and_moving(self.sets.awake()),
             &it,
         );
         self.scatter_solver_bodies();
@@ -214,7 +214,7 @@ impl World {
             let it = self.settings.joint_iterations(dt);
             self.solvers.joints.correct_positions(
                 &mut s.joint_constraints,
-                &mut self.inputs.bodies,
+                self.inputs.bodies_and_moving(self.sets.awake()),
                 dt,
                 &it,
                 method.solves_motors_with_contacts(),
