@@ -1,8 +1,8 @@
 //! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
 
-use super::SolverBody;
 use super::island::IslandGrouping;
 use super::pin_island::{PinIsland, displace_island};
+use super::{BodiesAndMoving, SolverBody};
 use crate::body::BodyHandle;
 use crate::math::{Rot, Vec2, clamp};
 
@@ -428,7 +428,7 @@ impl JointIslands {
     fn for_each(
         &mut self,
         joints: &mut [JointConstraint],
-        (bodies, moving): (&mut [SolverBody], &[u32]),
+        (bodies, moving): BodiesAndMoving<'_>,
         mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
     ) {
         let grouped = self.grouping.group(
@@ -465,7 +465,7 @@ impl JointBlockSolver {
     pub(crate) fn repair_positions(
         &mut self,
         joints: &mut [JointConstraint],
-        (bodies, moving): (&mut [SolverBody], &[u32]),
+        (bodies, moving): BodiesAndMoving<'_>,
         it: &JointIterations,
     ) {
         if joints
@@ -498,7 +498,7 @@ impl JointBlockSolver {
     pub(crate) fn correct_velocities(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: (&mut [SolverBody], &[u32]),
+        bodies: BodiesAndMoving<'_>,
         it: &JointIterations,
     ) {
         let pin_island = &mut self.pin_island;
@@ -517,7 +517,7 @@ impl JointBlockSolver {
     pub(crate) fn correct_positions(
         &mut self,
         joints: &mut [JointConstraint],
-        bodies: (&mut [SolverBody], &[u32]),
+        bodies: BodiesAndMoving<'_>,
         dt: f64,
         it: &JointIterations,
         motors_started: bool,

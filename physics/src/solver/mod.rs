@@ -14,6 +14,10 @@ pub(crate) mod system;
 use crate::body::Body;
 use crate::math::{Vec2, cross, cross_scalar};
 
+/// The bodies handed to a solver, by slot, and the slots of those that move, increasing
+/// (every other body is fixed for the solver).
+pub(crate) type BodiesAndMoving<'a> = (&'a mut [SolverBody], &'a [u32]);
+
 /// What a solver needs of a body: its velocity, inverse mass and where its centroid is.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct SolverBody {

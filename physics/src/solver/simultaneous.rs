@@ -2,12 +2,12 @@
 //! friction, and the coupled model that solves normals, friction, pins and joint motors in
 //! one boxed LCP whose friction bounds follow the normal impulses.
 
-use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
 use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+use super::{BodiesAndMoving, SolverBody};
 use crate::math::{Vec2, clamp};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
@@ -155,7 +155,7 @@ impl SimultaneousSolver {
         model: FrictionModel,
         contacts: &mut [Contact],
         joints: &mut [JointConstraint],
-        (bodies, moving): (&mut [SolverBody], &[u32]),
+        (bodies, moving): BodiesAndMoving<'_>,
         targets: &VelocityTargets,
     ) {
         self.reports.clear();
@@ -193,7 +193,7 @@ impl SimultaneousSolver {
         &mut self,
         contacts: &mut [Contact],
         joints: &[JointConstraint],
-        (bodies, moving): (&mut [SolverBody], &[u32]),
+        (bodies, moving): BodiesAndMoving<'_>,
         targets: &VelocityTargets,
     ) {
         // As in `propagate_impacts`: and the soft step's own bounce off a fixed body places
@@ -257,7 +257,7 @@ impl SimultaneousSolver {
         &mut self,
         contacts: &[Contact],
         joints: &[JointConstraint],
-        (bodies, moving): (&mut [SolverBody], &[u32]),
+        (bodies, moving): BodiesAndMoving<'_>,
         dt: f64,
         slop: f64,
         rate: f64,

@@ -9,7 +9,7 @@ use crate::solver::joint::JointMotor;
 use crate::solver::joint::{JointBlockSolver, JointConstraint, JointIterations};
 use crate::solver::simultaneous::FrictionModel;
 use crate::solver::system::VelocityTargets;
-use crate::solver::{ImpulseMethod, SolverBody};
+use crate::solver::{BodiesAndMoving, ImpulseMethod};
 
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
 /// at once overshoots in stacks, where pushes add up along the column.
@@ -123,12 +123,7 @@ impl World {
     fn joint_pass(
         &mut self,
         dt: f64,
-        pass: fn(
-            &mut JointBlockSolver,
-            &mut [JointConstraint],
-            (&mut [SolverBody], &[u32]),
-            &JointIterations,
-        ),
+        pass: fn(&mut JointBlockSolver, &mut [JointConstraint], BodiesAndMoving, &JointIterations),
     ) {
         if self.joints.is_empty() {
             return;

@@ -5,8 +5,8 @@ use super::World;
 use super::body_sets::EpochSeen;
 use crate::body::BodyHandle;
 use crate::math::Vec2;
-use crate::solver::SolverBody;
 use crate::solver::joint::{JointConstraint, velocity_gap_target};
+use crate::solver::{BodiesAndMoving, SolverBody};
 
 /// Whether gathering the joints works out the gap each is to close (`gap_target`): the
 /// exact and thesis solvers repair a broken joint over several steps; the soft step
@@ -37,7 +37,7 @@ pub(super) struct SolverInputs {
 
 impl SolverInputs {
     /// The bodies, and the slots of those that move: the `awake` ones not held.
-    pub(super) fn bodies_and_moving(&mut self, awake: &[u32]) -> (&mut [SolverBody], &[u32]) {
+    pub(super) fn bodies_and_moving(&mut self, awake: &[u32]) -> BodiesAndMoving<'_> {
         let bodies = &self.bodies;
         self.moving.clear();
         self.moving.extend(
