@@ -30,10 +30,6 @@ impl BodySets {
         self.stale = true;
     }
 
-    pub(super) fn epoch(&self) -> u64 {
-        self.epoch
-    }
-
     /// Sorts the bodies into the sets again if anything changed since the last time.
     pub(super) fn refresh(&mut self, bodies: &[Option<Body>]) {
         if !std::mem::take(&mut self.stale) {
@@ -76,11 +72,47 @@ impl BodySets {
         &self.sleeping
     }
 
+    /// The slots whose kept results are to be made again: every one of the `slots` if the
+    /// sets changed since `made` or the kept results are not `whole` (one for every
+    /// slot, made for the same inputs), else only the awake ones.
+    pub(super) fn to_remake(&self, made: &mut EpochSeen, whole: bool, slots: usize) -> Slots<'_> {
+        if made.sets_changed(self) || !whole {
+            Slots::Every(0..slots as u32)
+        } else {
+            Slots::Awake(self.awake().iter())
+        }
+    }
+
     /// Whether some body is asleep, and whether some body is awake (current after
     /// `refresh`).
     pub(super) fn some_asleep_and_awake(&self) -> (bool, bool) {
         debug_assert!(!self.stale, "read before refresh");
         (!self.sleeping.is_empty(), !self.awake.is_empty())
+    }
+}
+
+/// The slots whose kept results are made again (`BodySets::to_remake`): every one, or
+/// the awake bodies'.
+#[derive(Debug, Clone)]
+pub(super) enum Slots<'a> {
+    Every(std::ops::Range<u32>),
+    Awake(std::slice::Iter<'a, u32>),
+}
+
+impl Slots<'_> {
+    /// Every slot, not only the awake ones.
+    pub(super) fn every(&self) -> bool {
+        matches!(self, Slots::Every(_))
+    }
+}
+
+impl Iterator for Slots<'_> {
+    type Item = u32;
+    fn next(&mut self) -> Option<u32> {
+        match self {
+            Slots::Every(range) => range.next(),
+            Slots::Awake(slots) => slots.next().copied(),
+        }
     }
 }
 
@@ -95,5 +127,10 @@ impl EpochSeen {
     pub(super) fn sets_changed(&mut self, sets: &BodySets) -> bool {
         let now = Some(sets.epoch);
         std::mem::replace(&mut self.0, now) != now
+    }
+
+    /// The epoch last seen, if any.
+    pub(super) fn epoch(&self) -> Option<u64> {
+        self.0
     }
 }

@@ -2,7 +2,7 @@
 //! bodies' made again at every step, the static and sleeping bodies' only when the sets
 //! change (or the step length or the contact margin does).
 
-use super::body_sets::BodySets;
+use super::body_sets::{BodySets, EpochSeen, Slots};
 use crate::body::Body;
 use crate::collide::reuse::Pose;
 use crate::collide::{Aabb, WorldPolygon};
@@ -23,9 +23,10 @@ pub(super) struct BodyBounds {
     /// point.
     pub(super) reach: Vec<f64>,
     pub(super) motion: Vec<(Vec2, f64)>,
-    /// The sets' epoch, step length and contact margin (bits) the static and sleeping
-    /// bodies' were made with.
-    made_for: Option<(u64, u64, u64)>,
+    /// When the static and sleeping bodies' were made, and for which step length and
+    /// contact margin (bits).
+    made: EpochSeen,
+    made_at: Option<(u64, u64)>,
 }
 
 impl BodyBounds {
@@ -39,10 +40,11 @@ impl BodyBounds {
         margin: f64,
     ) -> Slots<'s> {
         let n = bodies.len();
-        let made_for = (sets.epoch(), dt.to_bits(), margin.to_bits());
-        let every_body = self.made_for != Some(made_for) || self.boxes.len() != n;
-        if every_body {
-            self.made_for = Some(made_for);
+        let made_at = Some((dt.to_bits(), margin.to_bits()));
+        let whole = self.made_at == made_at && self.boxes.len() == n;
+        let made = sets.to_remake(&mut self.made, whole, n);
+        if made.every() {
+            self.made_at = made_at;
             self.polygons.resize_with(n, WorldPolygon::default);
             self.outlined_at.resize(n, None);
             self.boxes.resize(n, None);
@@ -50,11 +52,6 @@ impl BodyBounds {
             self.motion.resize(n, (Vec2::zeros(), 0.0));
             self.poses.resize(n, Pose::default());
         }
-        let made = if every_body {
-            Slots::Every(0..n as u32)
-        } else {
-            Slots::Awake(sets.awake().iter())
-        };
         for i in made.clone() {
             self.make_one(i as usize, bodies[i as usize].as_ref(), dt, margin);
         }
@@ -85,25 +82,10 @@ impl BodyBounds {
         self.boxes[i] = outline.map(|(.., aabb)| aabb.grown(0.5 * margin + reach));
     }
 
-    /// What the static and sleeping bodies' bounds were last made for (see `made_for`).
+    /// What the static and sleeping bodies' bounds were last made for: the sets' epoch,
+    /// the step length and the contact margin (bits).
     pub(super) fn made_for(&self) -> Option<(u64, u64, u64)> {
-        self.made_for
-    }
-}
-
-/// The slots whose bounds a step makes: every one, or the awake bodies'.
-#[derive(Debug, Clone)]
-pub(super) enum Slots<'a> {
-    Every(std::ops::Range<u32>),
-    Awake(std::slice::Iter<'a, u32>),
-}
-
-impl Iterator for Slots<'_> {
-    type Item = u32;
-    fn next(&mut self) -> Option<u32> {
-        match self {
-            Slots::Every(range) => range.next(),
-            Slots::Awake(slots) => slots.next().copied(),
-        }
+        let (dt, margin) = self.made_at?;
+        Some((self.made.epoch()?, dt, margin))
     }
 }

@@ -26,19 +26,18 @@ impl World {
     pub(super) fn integrate_velocities(&mut self, dt: f64) {
         let velocity = |b: &Body| (b.velocity, b.angular_velocity);
         let inputs = &mut self.inputs;
-        let changed = inputs.start_velocities_made.sets_changed(&self.sets);
-        if changed || inputs.start_velocities.len() != self.bodies.len() {
+        let n = self.bodies.len();
+        let whole = inputs.start_velocities.len() == n;
+        let remake = self
+            .sets
+            .to_remake(&mut inputs.start_velocities_made, whole, n);
+        if remake.every() {
             inputs.start_velocities.clear();
-            inputs.start_velocities.extend(
-                self.bodies
-                    .iter()
-                    .map(|b| b.as_ref().map_or((Vec2::zeros(), 0.0), velocity)),
-            );
-        } else {
-            for &i in self.sets.awake() {
-                let b = self.bodies[i as usize].as_ref().expect("an awake body");
-                inputs.start_velocities[i as usize] = velocity(b);
-            }
+            inputs.start_velocities.resize(n, (Vec2::zeros(), 0.0));
+        }
+        for i in remake {
+            let body = self.bodies[i as usize].as_ref();
+            inputs.start_velocities[i as usize] = body.map_or((Vec2::zeros(), 0.0), velocity);
         }
         for &i in self.sets.awake() {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
@@ -80,11 +79,10 @@ impl World {
             b.force = Vec2::zeros();
             b.torque = 0.0;
         };
-        if self.forces_cleared.sets_changed(&self.sets) {
-            self.bodies.iter_mut().flatten().for_each(clear);
-        } else {
-            for &i in self.sets.awake() {
-                clear(self.bodies[i as usize].as_mut().expect("an awake body"));
+        let n = self.bodies.len();
+        for i in self.sets.to_remake(&mut self.forces_cleared, true, n) {
+            if let Some(b) = self.bodies[i as usize].as_mut() {
+                clear(b);
             }
         }
     }

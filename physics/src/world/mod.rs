@@ -699,22 +699,23 @@ impl World {
         self.gather_solver_bodies_with(GapTargets::None);
         // Zero but for the bodies the step moves (the ground's, last, among the zeros).
         let inputs = &mut self.inputs;
-        let changed = inputs.accelerations_made.sets_changed(&self.sets);
-        if changed || inputs.accelerations.len() != self.bodies.len() + 1 {
+        let n = self.bodies.len();
+        let whole = inputs.accelerations.len() == n + 1;
+        let remake = self
+            .sets
+            .to_remake(&mut inputs.accelerations_made, whole, n);
+        if remake.every() {
             inputs.accelerations.clear();
-            inputs
-                .accelerations
-                .resize(self.bodies.len() + 1, (Vec2::zeros(), 0.0));
+            inputs.accelerations.resize(n + 1, (Vec2::zeros(), 0.0));
         }
-        for &i in self.sets.awake() {
-            let b = self.bodies[i as usize].as_ref().expect("an awake body");
-            inputs.accelerations[i as usize] = if b.is_fixed() {
-                (Vec2::zeros(), 0.0) // held by `auto` for this pass
-            } else {
-                (
+        for i in remake {
+            // Fixed: static, asleep, or held by `auto` for this pass.
+            inputs.accelerations[i as usize] = match &self.bodies[i as usize] {
+                Some(b) if !b.is_fixed() => (
                     self.gravity + b.force * b.inv_mass,
                     b.torque * b.inv_inertia,
-                )
+                ),
+                _ => (Vec2::zeros(), 0.0),
             };
         }
         // The impact pass runs only where two moving bodies may bounce (a pile of cor 0

@@ -63,20 +63,16 @@ impl World {
         // Static and sleeping bodies are copied when the sets change; the solvers move
         // neither, so their copies stay as made.
         let inputs = &mut self.inputs;
-        let changed = inputs.bodies_made.sets_changed(&self.sets);
-        if changed || inputs.bodies.len() != self.bodies.len() + 1 {
+        let n = self.bodies.len();
+        let whole = inputs.bodies.len() == n + 1;
+        let remake = self.sets.to_remake(&mut inputs.bodies_made, whole, n);
+        if remake.every() {
             inputs.bodies.clear();
-            inputs.bodies.extend(
-                self.bodies
-                    .iter()
-                    .map(|b| b.as_ref().map(SolverBody::from_body).unwrap_or_default()),
-            );
-            inputs.bodies.push(SolverBody::default());
-        } else {
-            for &i in self.sets.awake() {
-                let body = self.bodies[i as usize].as_ref().expect("an awake body");
-                inputs.bodies[i as usize] = SolverBody::from_body(body);
-            }
+            inputs.bodies.resize(n + 1, SolverBody::default());
+        }
+        for i in remake {
+            let body = self.bodies[i as usize].as_ref();
+            inputs.bodies[i as usize] = body.map(SolverBody::from_body).unwrap_or_default();
         }
         s.joint_constraints.clear();
         for (i, j) in self.joints.iter().enumerate() {
