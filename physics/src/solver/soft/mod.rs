@@ -21,6 +21,35 @@ use crate::world::stats::StepStats;
 use batch::{LanePath, PassPlan, PassSettings, PlanInput};
 use pins::PinPlan;
 
+/// `$entry`, running `$inline` compiled with FMA where the processor has it (the copy
+/// `$fma`, with the feature enabled) and as built otherwise: `f64::mul_add` is then one
+/// instruction instead of a library call, with the same bits either way. (The feature must
+/// be on the function itself: a closure handed to a helper is compiled without it.)
+macro_rules! with_fma_where_present {
+    (
+        $(#[$doc:meta])*
+        $vis:vis fn $entry:ident, $fma:ident => $inline:ident(
+            &mut self $(, $arg:ident: $ty:ty)* $(,)?
+        ) $(-> $ret:ty)?;
+    ) => {
+        $(#[$doc])*
+        $vis fn $entry(&mut self $(, $arg: $ty)*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            if $crate::solver::soft::batch::LanePath::has_fma() {
+                // SAFETY: the processor has FMA, checked just above.
+                return unsafe { self.$fma($($arg),*) };
+            }
+            self.$inline($($arg),*)
+        }
+
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "fma")]
+        unsafe fn $fma(&mut self $(, $arg: $ty)*) $(-> $ret)? {
+            self.$inline($($arg),*)
+        }
+    };
+}
+
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 #[cfg(target_arch = "x86_64")]

@@ -113,22 +113,13 @@ impl SoftStepSolver {
         }
     }
 
-    /// Warm-starts the plan's `items`, in their order.
-    pub(super) fn warm_start_items(&mut self, items: Range<usize>, ask: bool) {
-        // The points' fused multiply–adds as one instruction where the processor has FMA
-        // (as in `build_points`): the same bits either way.
-        #[cfg(target_arch = "x86_64")]
-        if LanePath::has_fma() {
-            // SAFETY: the processor has FMA, checked just above.
-            return unsafe { self.warm_start_items_with_fma(items, ask) };
-        }
-        self.warm_start_items_inline(items, ask)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "fma")]
-    unsafe fn warm_start_items_with_fma(&mut self, items: Range<usize>, ask: bool) {
-        self.warm_start_items_inline(items, ask)
+    with_fma_where_present! {
+        /// Warm-starts the plan's `items`, in their order.
+        pub(super) fn warm_start_items, warm_start_items_with_fma => warm_start_items_inline(
+            &mut self,
+            items: Range<usize>,
+            ask: bool,
+        );
     }
 
     #[inline(always)]
@@ -152,34 +143,17 @@ impl SoftStepSolver {
         }
     }
 
-    /// One pass over the plan's `items`, in their order or backwards: eight manifolds at
-    /// a time where they are batched (see `batch`), the rest with FMA where the processor
-    /// has it (as `warm_start_items`).
-    pub(super) fn sweep_items(
-        &mut self,
-        items: Range<usize>,
-        pass: &PassSettings,
-        order: SweepOrder,
-        ask: bool,
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if LanePath::has_fma() {
-            // SAFETY: the processor has FMA, checked just above.
-            return unsafe { self.sweep_items_with_fma(items, pass, order, ask) };
-        }
-        self.sweep_items_inline(items, pass, order, ask)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "fma")]
-    unsafe fn sweep_items_with_fma(
-        &mut self,
-        items: Range<usize>,
-        pass: &PassSettings,
-        order: SweepOrder,
-        ask: bool,
-    ) {
-        self.sweep_items_inline(items, pass, order, ask)
+    with_fma_where_present! {
+        /// One pass over the plan's `items`, in their order or backwards: eight manifolds
+        /// at a time where they are batched (see `batch`), the rest with FMA where the
+        /// processor has it.
+        pub(super) fn sweep_items, sweep_items_with_fma => sweep_items_inline(
+            &mut self,
+            items: Range<usize>,
+            pass: &PassSettings,
+            order: SweepOrder,
+            ask: bool,
+        );
     }
 
     #[inline(always)]

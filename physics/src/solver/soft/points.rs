@@ -2,7 +2,7 @@
 //! impulses recalled, each manifold placed in its lane or written; and the plan made
 //! from the contacts before the points, where it changed last step.
 
-use super::batch::{LanePath, PlanInput};
+use super::batch::PlanInput;
 use super::contact_lcp::LCP_POINT_LIMIT;
 use super::prepare::island_ranges;
 use super::{NormalBlock, PointConstraint, PointLevers, SoftStepSolver, row_coupling};
@@ -125,51 +125,28 @@ impl SoftStepSolver {
         island_ranges(grouped, &mut self.contact_islands);
     }
 
-    /// The contacts' points, in the order of `grouped` (island by island), their
-    /// manifolds' entries for the plan (`plan_inputs`), and `may_bounce`. A manifold
-    /// that goes into the kept plan's lanes (`PassPlan::fill_manifold`) is not written to
-    /// `points`, unless its island is small enough to be solved as an LCP (which reads
-    /// its points): its entries there are left from an earlier step. Returns whether any
-    /// was left so. Such entries are read only by a changed plan and where something may
-    /// bounce (restitution, and the impulses stored from the points), and `prepare` then
-    /// builds the points again, with the filling stopped.
-    ///
-    /// With `unchecked_ends` (the ends of the contacts that `grouped` grouped, by contact),
-    /// each contact's bodies are checked against them as its point is built, and one that
-    /// differs stops the building at its island's end: the grouping is not this step's.
-    pub(super) fn build_points(
-        &mut self,
-        bodies: &[SolverBody],
-        accelerations: &[(Vec2, f64)],
-        contacts: &[Contact],
-        grouping: ContactGrouping,
-        dt: f64,
-    ) -> Result<bool, ContactsRegrouped> {
-        // The points' fused multiply–adds (`f64::mul_add`) are one instruction where the
-        // processor has FMA and a library call where the build does not assume it (a
-        // tenth of the CLI's step on a pile): the same code, compiled both ways, the same
-        // bits either way.
-        #[cfg(target_arch = "x86_64")]
-        if LanePath::has_fma() {
-            // SAFETY: the processor has FMA, checked just above.
-            return unsafe {
-                self.build_points_with_fma(bodies, accelerations, contacts, grouping, dt)
-            };
-        }
-        self.build_points_inline(bodies, accelerations, contacts, grouping, dt)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "fma")]
-    unsafe fn build_points_with_fma(
-        &mut self,
-        bodies: &[SolverBody],
-        accelerations: &[(Vec2, f64)],
-        contacts: &[Contact],
-        grouping: ContactGrouping,
-        dt: f64,
-    ) -> Result<bool, ContactsRegrouped> {
-        self.build_points_inline(bodies, accelerations, contacts, grouping, dt)
+    with_fma_where_present! {
+        /// The contacts' points, in the order of `grouped` (island by island), their
+        /// manifolds' entries for the plan (`plan_inputs`), and `may_bounce`. A manifold
+        /// that goes into the kept plan's lanes (`PassPlan::fill_manifold`) is not written
+        /// to `points`, unless its island is small enough to be solved as an LCP (which
+        /// reads its points): its entries there are left from an earlier step. Returns
+        /// whether any was left so. Such entries are read only by a changed plan and where
+        /// something may bounce (restitution, and the impulses stored from the points), and
+        /// `prepare` then builds the points again, with the filling stopped.
+        ///
+        /// With `unchecked_ends` (the ends of the contacts that `grouped` grouped, by
+        /// contact), each contact's bodies are checked against them as its point is built,
+        /// and one that differs stops the building at its island's end: the grouping is not
+        /// this step's.
+        pub(super) fn build_points, build_points_with_fma => build_points_inline(
+            &mut self,
+            bodies: &[SolverBody],
+            accelerations: &[(Vec2, f64)],
+            contacts: &[Contact],
+            grouping: ContactGrouping,
+            dt: f64,
+        ) -> Result<bool, ContactsRegrouped>;
     }
 
     #[inline(always)]
