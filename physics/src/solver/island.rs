@@ -182,6 +182,24 @@ impl IslandGrouping {
     }
 }
 
+/// The slots of two increasing lists, increasing, each once.
+pub(crate) fn merged_increasing<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = u32> + 'a {
+    let (mut a, mut b) = (a.iter().copied().peekable(), b.iter().copied().peekable());
+    std::iter::from_fn(move || match (a.peek(), b.peek()) {
+        (Some(&x), Some(&y)) => {
+            if x <= y {
+                a.next();
+            }
+            if y <= x {
+                b.next();
+            }
+            Some(x.min(y))
+        }
+        (Some(_), None) => a.next(),
+        (None, _) => b.next(),
+    })
+}
+
 /// `items` sorted stably by `key` (below `keys`) into `out`, in O(items + keys); `starts`
 /// is scratch, kept by the caller so that a step allocates nothing.
 pub(crate) fn counting_sort<T: Copy>(

@@ -5,6 +5,7 @@
 use super::World;
 use crate::body::Body;
 use crate::collide::{Aabb, FixedCells};
+use crate::solver::island::merged_increasing;
 
 /// While the broad phase pairs the bodies again every time, every this many pairings use
 /// grown bounds, to see whether they hold again (`find_candidate_pairs`).
@@ -235,12 +236,10 @@ impl World {
             };
             let fixed_slots = &mut kept.fixed_slots;
             fixed_slots.clear();
-            fixed_slots.extend_from_slice(self.sets.statics());
-            fixed_slots.extend_from_slice(self.sets.sleeping());
+            fixed_slots.extend(merged_increasing(self.sets.statics(), self.sets.sleeping()));
             if fixed_slots.len() < FIXED_CELLS_FROM {
                 s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
             } else {
-                fixed_slots.sort_unstable();
                 let listed_with = (made_for, grow.to_bits());
                 if kept.fixed_cells_for != Some(listed_with) {
                     kept.fixed_cells.build(&kept.bounds, fixed_slots);

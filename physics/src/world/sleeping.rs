@@ -5,6 +5,7 @@ use super::World;
 use crate::body::{Body, BodyHandle};
 use crate::collide::Aabb;
 use crate::math::Vec2;
+use crate::solver::island::merged_increasing;
 
 /// Seconds an island must stay still before it sleeps.
 const SLEEP_AFTER: f64 = 0.5;
@@ -56,9 +57,8 @@ impl World {
             s.wake_boxes.resize(n, None);
             s.wake_reach.resize(n, 0.0);
             s.wake_slots.clear();
-            s.wake_slots.extend_from_slice(self.sets.awake());
-            s.wake_slots.extend_from_slice(self.sets.sleeping());
-            s.wake_slots.sort_unstable();
+            let (awake, sleeping) = (self.sets.awake(), self.sets.sleeping());
+            s.wake_slots.extend(merged_increasing(awake, sleeping));
             for &i in &s.wake_slots {
                 let b = self.bodies[i as usize]
                     .as_ref()

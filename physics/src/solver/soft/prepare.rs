@@ -7,7 +7,7 @@ use super::{SoftBody, SoftJoint, SoftStepSolver};
 use crate::math::{Rot, Vec2};
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
-use crate::solver::island::IslandGrouping;
+use crate::solver::island::{IslandGrouping, merged_increasing};
 use crate::solver::joint::JointConstraint;
 use crate::stage_clock::{self, Stage};
 
@@ -308,22 +308,4 @@ pub(super) fn island_ranges(grouped: &[(u32, u32)], ranges: &mut Vec<(usize, usi
         ranges.push((start, start + len));
         start += len;
     }
-}
-
-/// The slots of two increasing lists, increasing, each once.
-fn merged_increasing<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = u32> + 'a {
-    let (mut a, mut b) = (a.iter().copied().peekable(), b.iter().copied().peekable());
-    std::iter::from_fn(move || match (a.peek(), b.peek()) {
-        (Some(&x), Some(&y)) => {
-            if x <= y {
-                a.next();
-            }
-            if y <= x {
-                b.next();
-            }
-            Some(x.min(y))
-        }
-        (Some(_), None) => a.next(),
-        (None, _) => b.next(),
-    })
 }
