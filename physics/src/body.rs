@@ -238,31 +238,19 @@ impl Body {
     pub fn is_asleep(&self) -> bool {
         self.asleep
     }
+    /// Asleep: fixed where it is, still, until woken.
     pub(crate) fn fall_asleep(&mut self) {
         self.asleep = true;
-        self.hold();
-    }
-    /// Held still, as if asleep, for one pass of a step that moves the rest of the world
-    /// (a body of the other solver's islands under `ContactSolver::Auto`). Returns its
-    /// velocity, for `release`: a held body that kept it would look to the pass as if it
-    /// were still to move this step, which it has done or will do in its own pass.
-    pub(crate) fn hold(&mut self) -> (Vec2, f64) {
         self.inv_mass = 0.0;
         self.inv_inertia = 0.0;
-        let velocity = (self.velocity, self.angular_velocity);
         (self.velocity, self.angular_velocity) = (Vec2::zeros(), 0.0);
-        velocity
-    }
-    pub(crate) fn release(&mut self, (velocity, angular_velocity): (Vec2, f64)) {
-        self.movable_again();
-        (self.velocity, self.angular_velocity) = (velocity, angular_velocity);
     }
     pub(crate) fn wake(&mut self) {
         self.asleep = false;
         self.still_time = 0.0;
         self.movable_again();
     }
-    /// The inverse mass and inertia back from the mass properties (see `hold`).
+    /// The inverse mass and inertia back from the mass properties (see `fall_asleep`).
     fn movable_again(&mut self) {
         self.inv_mass = self.inv_mass();
         self.inv_inertia = self.inv_inertia();

@@ -41,6 +41,18 @@ impl SolverBody {
         }
     }
 
+    /// A body held still for a pass of `auto`: as the solvers see a sleeping one, fixed
+    /// where it is.
+    pub(crate) fn held_still(body: &Body) -> Self {
+        Self {
+            velocity: Vec2::zeros(),
+            angular_velocity: 0.0,
+            inv_mass: 0.0,
+            inv_inertia: 0.0,
+            ..Self::from_body(body)
+        }
+    }
+
     /// Whether impulses move the body (not static, not held by `auto`).
     pub(crate) fn moves(&self) -> bool {
         self.inv_mass > 0.0 || self.inv_inertia > 0.0

@@ -1,5 +1,5 @@
-//! `auto`: each island goes to `exact` or to the soft step, each solver's pass holding
-//! the other's bodies still.
+//! `auto`: each island goes to `exact` or to the soft step, each solver's pass moving
+//! its part of the awake set and holding the other's bodies still (`BodySets`).
 
 use super::World;
 use crate::solver::ImpulseMethod;
@@ -272,38 +272,28 @@ impl World {
         }
     }
 
-    /// Holds every moving body whose island is (`soft`) or is not (`!soft`) the soft
-    /// step's.
+    /// Starts a pass that holds every awake body whose island is (`soft`) or is not
+    /// (`!soft`) the soft step's.
     fn hold_where(&mut self, soft: bool) {
-        let s = &mut self.scratch;
-        s.held.clear();
-        for (i, body) in self.bodies.iter_mut().enumerate() {
-            if let Some(b) = body
-                && !b.is_fixed()
-                && s.in_soft_island[i] == soft
-            {
-                s.held.push((i as u32, b.hold()));
-            }
-        }
+        let in_soft_island = &self.scratch.in_soft_island;
+        let held = |i: u32| in_soft_island[i as usize] == soft;
+        self.sets.hold_for_pass(self.bodies.len(), held);
     }
 
     fn release_held(&mut self) {
-        for &(i, velocity) in &self.scratch.held {
-            if let Some(b) = self.bodies[i as usize].as_mut() {
-                b.release(velocity);
-            }
-        }
-        self.scratch.held.clear();
+        self.sets.end_pass();
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::tests::{overlapping_pairs, pyramid_under_auto};
-    use crate::body::BodyDef;
+    use crate::body::{Body, BodyDef};
     use crate::math::Vec2;
     use crate::shape::ConvexPolygon;
+    use crate::solver::ImpulseMethod;
     use crate::solver::joint::JointMotor;
+    use crate::world::World;
     use crate::world::{JointDef, StepSettings};
 
     /// `auto` holds the soft islands' bodies for its exact pass and the exact ones' for
@@ -311,20 +301,7 @@ mod tests {
     /// candidates are exactly the overlapping pairs of which a body moves in that pass.
     #[test]
     fn candidates_leave_out_the_pairs_held_still_in_each_pass_of_auto() {
-        let mut world = pyramid_under_auto();
-        // Apart from the pyramid (a soft island), two stacks of two, each topped by a
-        // box twenty times as heavy (exact ones).
-        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-        for x in [20.0, 25.0] {
-            for (y, density) in [(-0.5, 1.0), (-1.5, 20.0)] {
-                let def = BodyDef::new(unit.clone(), density).at(Vec2::new(x, y), 0.1);
-                world.add_body(def).unwrap();
-            }
-        }
-        let dt = 1.0 / 60.0;
-        for _ in 0..5 {
-            world.step(dt);
-        }
+        let (mut world, dt) = pyramid_beside_heavy_stacks();
         assert_eq!(world.mark_soft_islands(dt), (true, true));
         let unheld = world.scratch.pairs.clone();
         assert_eq!(unheld, overlapping_pairs(&world));
@@ -341,6 +318,75 @@ mod tests {
         }
         // Each pass has pairs of its own: the pyramid's, and the stacks' and floor's.
         assert!(moving_in_pass.iter().all(|&n| n > 2), "{moving_in_pass:?}");
+    }
+
+    /// The pyramid of `pyramid_under_auto` (a soft island) and, apart from it, two stacks
+    /// of two, each topped by a box twenty times as heavy (exact ones), five steps on.
+    fn pyramid_beside_heavy_stacks() -> (World, f64) {
+        let mut world = pyramid_under_auto();
+        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
+        for x in [20.0, 25.0] {
+            for (y, density) in [(-0.5, 1.0), (-1.5, 20.0)] {
+                let def = BodyDef::new(unit.clone(), density).at(Vec2::new(x, y), 0.1);
+                world.add_body(def).unwrap();
+            }
+        }
+        let dt = 1.0 / 60.0;
+        for _ in 0..5 {
+            world.step(dt);
+        }
+        (world, dt)
+    }
+
+    /// Each pass of `auto` moves the bodies of its islands and leaves the other pass's
+    /// bodies as they are, to the bit, while it runs (their velocities and masses among
+    /// it): a pass holds bodies in the sets, not by changing them.
+    #[test]
+    fn each_pass_of_auto_moves_its_part_and_leaves_the_held_bodies_as_they_are() {
+        let (mut world, dt) = pyramid_beside_heavy_stacks();
+        assert_eq!(world.mark_soft_islands(dt), (true, true));
+        let state = |b: &Body| {
+            let (v, w) = (b.velocity, b.angular_velocity);
+            [
+                b.position.x,
+                b.position.y,
+                b.angle,
+                v.x,
+                v.y,
+                w,
+                b.inv_mass,
+                b.inv_inertia,
+            ]
+            .map(f64::to_bits)
+        };
+        for soft_held in [true, false] {
+            let before: Vec<_> = world.bodies.iter().flatten().map(state).collect();
+            world.hold_where(soft_held);
+            let held: Vec<bool> = (0..before.len() as u32)
+                .map(|i| world.sets.is_held(i))
+                .collect();
+            if soft_held {
+                world.step_impulses(ImpulseMethod::Exact, dt);
+            } else {
+                world.step_soft(dt);
+            }
+            let moving = world.sets.moving().to_vec();
+            let after: Vec<_> = world.bodies.iter().flatten().map(state).collect();
+            world.release_held();
+            let held_count = held.iter().filter(|&&h| h).count();
+            // The pyramid's 55 boxes, or the stacks' 4.
+            assert_eq!(held_count, if soft_held { 55 } else { 4 });
+            for (i, (was, is)) in before.iter().zip(&after).enumerate() {
+                if held[i] {
+                    assert_eq!(was, is, "held body {i} changed");
+                }
+            }
+            assert_eq!(moving.len(), 59 - held_count);
+            for &i in &moving {
+                let (was, is) = (&before[i as usize], &after[i as usize]);
+                assert_ne!(was[..6], is[..6], "body {i} did not move in its pass");
+            }
+        }
     }
 
     /// `auto` marks the soft islands again only when what the marks are made from changes:

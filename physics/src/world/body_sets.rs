@@ -8,8 +8,14 @@
 //! ones every step and the rest only when the `epoch` it saw has passed: when a body was
 //! added or removed, fell asleep or woke, or was handed out by `World::body_mut` while
 //! static or asleep (and so may have been moved by hand).
+//!
+//! Under `auto` a step runs in two passes, each over its part of the awake set: the
+//! other part is held, fixed for the pass (no velocity, no inverse mass) as a sleeping
+//! body is, while the bodies themselves are left as they are. Every stage of a pass sees
+//! the bodies through the sets (`moving`, `is_held`, `velocity_in_pass`).
 
 use crate::body::Body;
+use crate::math::{Vec2, cross_scalar};
 
 #[derive(Debug, Clone, Default)]
 pub(super) struct BodySets {
@@ -21,6 +27,10 @@ pub(super) struct BodySets {
     epoch: u64,
     /// The lists are to be sorted again from the bodies before they are next read.
     stale: bool,
+    /// In a pass of `auto`: per slot, whether the body is held (empty outside a pass).
+    held: Vec<bool>,
+    /// In a pass of `auto`: the awake bodies not held, increasing.
+    pass_moving: Vec<u32>,
 }
 
 impl BodySets {
@@ -35,6 +45,7 @@ impl BodySets {
         if !std::mem::take(&mut self.stale) {
             return;
         }
+        debug_assert!(self.held.is_empty(), "the sets changed within a pass");
         self.statics.clear();
         self.sleeping.clear();
         self.awake.clear();
@@ -53,11 +64,75 @@ impl BodySets {
         }
     }
 
-    /// The bodies a step moves (bodies `auto` holds for one of its passes among them).
-    /// Current only after `refresh`.
+    /// The bodies a step moves, those `auto` holds for one of its passes among them: the
+    /// bodies whose kept results are made again for each pass. Current only after
+    /// `refresh`.
     pub(super) fn awake(&self) -> &[u32] {
         debug_assert!(!self.stale, "read before refresh");
         &self.awake
+    }
+
+    /// The bodies this pass moves: the awake ones, less those held (current after
+    /// `refresh`).
+    pub(super) fn moving(&self) -> &[u32] {
+        if !self.in_pass() {
+            self.awake()
+        } else {
+            &self.pass_moving
+        }
+    }
+
+    /// Starts a pass of `auto` that holds the awake bodies for which `held` is true: they
+    /// are fixed to every stage of the pass until `end_pass`.
+    pub(super) fn hold_for_pass(&mut self, slots: usize, held: impl Fn(u32) -> bool) {
+        debug_assert!(!self.stale, "read before refresh");
+        self.held.clear();
+        self.held.resize(slots, false);
+        self.pass_moving.clear();
+        for &i in &self.awake {
+            if held(i) {
+                self.held[i as usize] = true;
+            } else {
+                self.pass_moving.push(i);
+            }
+        }
+    }
+
+    /// Ends `auto`'s pass: every awake body moves again.
+    pub(super) fn end_pass(&mut self) {
+        self.held.clear();
+        self.pass_moving.clear();
+    }
+
+    /// Whether a pass of `auto` is under way (`hold_for_pass`).
+    pub(super) fn in_pass(&self) -> bool {
+        !self.held.is_empty()
+    }
+
+    /// Whether the body in `slot` is held still for this pass of `auto`.
+    pub(super) fn is_held(&self, slot: u32) -> bool {
+        self.held.get(slot as usize).is_some_and(|&held| held)
+    }
+
+    /// Whether this pass leaves the body in `slot` where it is: static, asleep or held.
+    pub(super) fn fixed_in_pass(&self, slot: u32, body: &Body) -> bool {
+        body.is_fixed() || self.is_held(slot)
+    }
+
+    /// The body's velocity and spin as this pass sees them: none for a body held still
+    /// (it moves in its own pass; seen moving here, it would be moved twice).
+    pub(super) fn velocity_in_pass(&self, slot: u32, body: &Body) -> (Vec2, f64) {
+        if self.is_held(slot) {
+            (Vec2::zeros(), 0.0)
+        } else {
+            (body.velocity, body.angular_velocity)
+        }
+    }
+
+    /// The velocity of the body's material point at `point` as this pass sees it.
+    pub(super) fn velocity_at_in_pass(&self, slot: u32, body: &Body, point: Vec2) -> Vec2 {
+        let (velocity, spin) = self.velocity_in_pass(slot, body);
+        velocity + cross_scalar(spin, point - body.position)
     }
 
     /// The static bodies (current after `refresh`).

@@ -53,15 +53,24 @@ impl BodyBounds {
             self.poses.resize(n, Pose::default());
         }
         for i in made.clone() {
-            self.make_one(i as usize, bodies[i as usize].as_ref(), dt, margin);
+            let body = bodies[i as usize].as_ref();
+            let velocity = body.map_or((Vec2::zeros(), 0.0), |b| sets.velocity_in_pass(i, b));
+            self.make_one(i as usize, body, velocity, dt, margin);
         }
         made
     }
 
-    fn make_one(&mut self, i: usize, body: Option<&Body>, dt: f64, margin: f64) {
+    /// `velocity`: the body's velocity and spin as the pass sees them.
+    fn make_one(
+        &mut self,
+        i: usize,
+        body: Option<&Body>,
+        (velocity, spin): (Vec2, f64),
+        dt: f64,
+        margin: f64,
+    ) {
         // The speed of its farthest point from the spin alone.
-        let spin = body.map_or(0.0, |b| b.angular_velocity.abs() * b.bounding_radius());
-        let velocity = body.map_or(Vec2::zeros(), |b| b.velocity);
+        let spin = body.map_or(0.0, |b| spin.abs() * b.bounding_radius());
         let reach = (velocity.norm() + spin) * dt;
         self.reach[i] = reach;
         self.motion[i] = (velocity * dt, spin * dt);

@@ -268,20 +268,19 @@ impl World {
             _ => false,
         };
         s.pairs.clear();
-        if s.held.is_empty() {
-            s.pairs.extend(kept.pairs.iter().copied().filter(overlap));
-        } else {
-            s.fixed_now.clear();
-            s.fixed_now
-                .extend(bodies.iter().map(|b| b.as_ref().is_none_or(Body::is_fixed)));
-            let fixed_now = &s.fixed_now;
-            let one_moves = |&(i, j): &(u32, u32)| !(fixed_now[i as usize] & fixed_now[j as usize]);
+        if self.sets.in_pass() {
+            // `auto`'s pass: a pair is wanted where one of its bodies moves in the pass.
+            let (fixed, sets) = (&kept.fixed, &self.sets);
+            let fixed_in_pass = |i: u32| fixed[i as usize] || sets.is_held(i);
+            let one_moves = |&(i, j): &(u32, u32)| !(fixed_in_pass(i) && fixed_in_pass(j));
             s.pairs.extend(
                 kept.pairs
                     .iter()
                     .copied()
                     .filter(|p| one_moves(p) && overlap(p)),
             );
+        } else {
+            s.pairs.extend(kept.pairs.iter().copied().filter(overlap));
         }
         if kept.crowded {
             s.grown_by.clear();

@@ -103,11 +103,12 @@ impl World {
                 b.friction.unwrap_or(self.friction),
             );
             let start = &self.inputs.start_velocities;
+            let sets = &self.sets;
             let approach = |h: BodyHandle, body: &Body, point: Vec2| {
                 let (v, w) = start
                     .get(h.index())
                     .copied()
-                    .unwrap_or((body.velocity, body.angular_velocity));
+                    .unwrap_or_else(|| sets.velocity_in_pass(h.0, body));
                 (v + crate::math::cross_scalar(w, point - body.position)).dot(&m.normal)
             };
             for p in m.points() {
@@ -118,7 +119,9 @@ impl World {
                 let normal_velocity = if start.is_empty() {
                     approach_velocity
                 } else {
-                    (a.velocity_at(p.position) - b.velocity_at(p.position)).dot(&m.normal)
+                    let velocity_a = sets.velocity_at_in_pass(m.body_a.0, a, p.position);
+                    let velocity_b = sets.velocity_at_in_pass(m.body_b.0, b, p.position);
+                    (velocity_a - velocity_b).dot(&m.normal)
                 };
                 self.contacts.push(Contact {
                     body_a: m.body_a,

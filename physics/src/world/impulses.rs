@@ -3,7 +3,6 @@
 //! impulses, bounces placed at impact, and the state saved to redo a step finer.
 
 use super::{MAX_SUBSTEPS, World};
-use crate::body::Body;
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
 use crate::solver::joint::{JointBlockSolver, JointConstraint, JointIterations};
@@ -24,19 +23,18 @@ impl World {
             .for_each(f);
     }
 
-    /// The awake bodies' poses and velocities, for `restore_state` (the step moves no
-    /// other body).
+    /// The poses and velocities of the bodies this pass moves, for `restore_state`.
     pub(super) fn save_state(&mut self) {
         let saved = &mut self.scratch.saved_state;
         saved.clear();
-        saved.extend(self.sets.awake().iter().map(|&i| {
+        saved.extend(self.sets.moving().iter().map(|&i| {
             let b = self.bodies[i as usize].as_ref().expect("an awake body");
             (b.position, b.angle, b.velocity, b.angular_velocity)
         }));
     }
 
     pub(super) fn restore_state(&mut self) {
-        for (&i, &(p, a, v, w)) in self.sets.awake().iter().zip(&self.scratch.saved_state) {
+        for (&i, &(p, a, v, w)) in self.sets.moving().iter().zip(&self.scratch.saved_state) {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
             (b.position, b.angle, b.velocity, b.angular_velocity) = (p, a, v, w);
         }
@@ -54,8 +52,8 @@ impl World {
             .flatten()
             .flat_map(|j| [Some(j.body_a), j.body_b])
             .flatten()
-            .filter_map(|h| self.body(h))
-            .map(|b| b.angular_velocity.abs())
+            .filter_map(|h| Some((h.0, self.body(h)?)))
+            .map(|(i, b)| self.sets.velocity_in_pass(i, b).1.abs())
             .fold(0.0, f64::max);
         ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SUBSTEPS)
     }
@@ -93,7 +91,10 @@ impl World {
             if gap <= 0.0 {
                 continue;
             }
-            let is_fixed = |i: u32| self.bodies[i as usize].as_ref().is_none_or(Body::is_fixed);
+            let is_fixed = |i: u32| {
+                let body = self.bodies[i as usize].as_ref();
+                body.is_none_or(|b| self.sets.fixed_in_pass(i, b))
+            };
             let (moving, direction) = match (is_fixed(c.body_a.0), is_fixed(c.body_b.0)) {
                 (false, true) => (c.body_a, -c.normal),
                 (true, false) => (c.body_b, c.normal),
@@ -134,7 +135,7 @@ impl World {
         pass(
             &mut self.solvers.joints,
             &mut s.joint_constraints,
-            self.inputs.bodies_and_moving(self.sets.awake()),
+            self.inputs.bodies_and_moving(self.sets.moving()),
             &it,
         );
         self.scatter_solver_bodies();
@@ -152,8 +153,11 @@ impl World {
                 continue;
             }
             let (ia, ib) = (m.body_a.index(), m.body_b.index());
-            let inv_a = self.bodies[ia].as_ref().map_or(0.0, |b| b.inv_mass);
-            let inv_b = self.bodies[ib].as_ref().map_or(0.0, |b| b.inv_mass);
+            let inv_mass = |i: usize| match self.bodies[i].as_ref() {
+                Some(b) if !self.sets.is_held(i as u32) => b.inv_mass,
+                _ => 0.0,
+            };
+            let (inv_a, inv_b) = (inv_mass(ia), inv_mass(ib));
             let total = inv_a + inv_b;
             if total == 0.0 {
                 continue;
@@ -200,7 +204,7 @@ impl World {
                     model,
                     &mut self.contacts,
                     &mut s.joint_constraints,
-                    self.inputs.bodies_and_moving(self.sets.awake()),
+                    self.inputs.bodies_and_moving(self.sets.moving()),
                     &targets,
                 );
             }
@@ -209,7 +213,7 @@ impl World {
             let it = self.settings.joint_iterations(dt);
             self.solvers.joints.correct_positions(
                 &mut s.joint_constraints,
-                self.inputs.bodies_and_moving(self.sets.awake()),
+                self.inputs.bodies_and_moving(self.sets.moving()),
                 dt,
                 &it,
                 method.solves_motors_with_contacts(),
@@ -220,7 +224,7 @@ impl World {
             self.solvers.exact.separate(
                 &self.contacts,
                 &s.joint_constraints,
-                self.inputs.bodies_and_moving(self.sets.awake()),
+                self.inputs.bodies_and_moving(self.sets.moving()),
                 dt,
                 self.settings.slop(),
                 SPLIT_IMPULSE_RATE,

@@ -24,7 +24,6 @@ impl World {
     /// (Every body's velocity is kept in `start_velocities` first, for restitution: the
     /// awake bodies' each time, the others' when the sets change.)
     pub(super) fn integrate_velocities(&mut self, dt: f64) {
-        let velocity = |b: &Body| (b.velocity, b.angular_velocity);
         let inputs = &mut self.inputs;
         let n = self.bodies.len();
         let whole = inputs.start_velocities.len() == n;
@@ -37,13 +36,11 @@ impl World {
         }
         for i in remake {
             let body = self.bodies[i as usize].as_ref();
+            let velocity = |b| self.sets.velocity_in_pass(i, b);
             inputs.start_velocities[i as usize] = body.map_or((Vec2::zeros(), 0.0), velocity);
         }
-        for &i in self.sets.awake() {
+        for &i in self.sets.moving() {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
-            if b.is_fixed() {
-                continue; // held by `auto` for this pass
-            }
             b.velocity += (self.gravity + b.force * b.inv_mass) * dt;
             b.angular_velocity += b.torque * b.inv_inertia * dt;
         }
@@ -53,11 +50,8 @@ impl World {
     pub(super) fn integrate_positions(&mut self, dt: f64) {
         let gravity = self.gravity;
         let explicit = self.settings.integrator == Integrator::ExplicitEuler;
-        for &i in self.sets.awake() {
+        for &i in self.sets.moving() {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
-            if b.is_fixed() {
-                continue; // held by `auto` for this pass
-            }
             let (v, w) = if explicit {
                 // Undo this step's force contribution: the position uses the old velocity,
                 // plus whatever impulses (contacts, joints) changed since.

@@ -258,8 +258,6 @@ struct Scratch {
     radii: Vec<f64>,
     grown_by: Vec<f64>,
     neighbours: NeighbourScratch,
-    /// Which bodies are fixed in this pass, held ones among them (`find_candidate_pairs`).
-    fixed_now: Vec<bool>,
     /// This step's manifolds' gaps less what their bodies can close of them, and how far
     /// a collision may turn each body off its course (`drop_idle_manifolds`).
     gaps: Vec<f64>,
@@ -280,16 +278,14 @@ struct Scratch {
     impacts: Vec<(u32, f64)>,
     impact_union: UnionFind,
     island_impact: Vec<f64>,
-    /// `auto`: the islands' links and row counts, which bodies are in big islands, the
-    /// bodies held in the current pass, and the exact pass's contacts while the soft pass
-    /// runs.
+    /// `auto`: the islands' links and row counts, which bodies are in the soft step's
+    /// islands, and the exact pass's contacts while the soft pass runs.
     auto_links: Vec<(u32, u32, usize)>,
     island_rows: Vec<usize>,
     island_needs: Vec<IslandNeeds>,
     /// Per body: whether it is kept on the soft step this step (`AutoMemory::soft_until`).
     prefer_soft: Vec<bool>,
     in_soft_island: Vec<bool>,
-    held: Vec<(u32, (Vec2, f64))>,
     exact_contacts: Vec<Contact>,
     exact_manifolds: Vec<Manifold>,
     /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
@@ -616,7 +612,6 @@ impl World {
         if self.settings.sleeping {
             self.wake_where_needed(dt);
         }
-        // Sorted before `auto` holds any body for a pass: the sets are the world's own.
         self.sets.refresh(&self.bodies);
         if self.settings.continuous {
             // Read for the awake bodies only.
@@ -709,9 +704,8 @@ impl World {
             inputs.accelerations.resize(n + 1, (Vec2::zeros(), 0.0));
         }
         for i in remake {
-            // Fixed: static, asleep, or held by `auto` for this pass.
             inputs.accelerations[i as usize] = match &self.bodies[i as usize] {
-                Some(b) if !b.is_fixed() => (
+                Some(b) if !self.sets.fixed_in_pass(i, b) => (
                     self.gravity + b.force * b.inv_mass,
                     b.torque * b.inv_inertia,
                 ),
@@ -810,7 +804,7 @@ impl World {
         self.solvers.exact.propagate_all_impacts(
             &mut self.contacts,
             &s.joint_constraints,
-            self.inputs.bodies_and_moving(self.sets.awake()),
+            self.inputs.bodies_and_moving(self.sets.moving()),
             &VelocityTargets {
                 dt,
                 bounce_below: restitution_threshold(self.gravity, dt),
@@ -933,10 +927,12 @@ mod tests {
         pairs_overlapping(world, &world.bounds.boxes)
     }
 
-    /// The pairs of `boxes` (by slot) that overlap, but for pairs of two fixed bodies.
+    /// The pairs of `boxes` (by slot) that overlap, but for pairs of two bodies fixed in
+    /// the pass.
     pub(super) fn pairs_overlapping(world: &World, boxes: &[Option<Aabb>]) -> Vec<(u32, u32)> {
         let n = boxes.len();
-        let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(Body::is_fixed);
+        let fixed_in_pass = |i: usize, b: &Body| world.sets.fixed_in_pass(i as u32, b);
+        let fixed = |i: usize| world.bodies[i].as_ref().is_none_or(|b| fixed_in_pass(i, b));
         (0..n)
             .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
             .filter(|&(i, j)| !(fixed(i) && fixed(j)))

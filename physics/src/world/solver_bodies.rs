@@ -25,9 +25,6 @@ pub(super) enum GapTargets {
 pub(super) struct SolverInputs {
     pub(super) bodies: Vec<SolverBody>,
     pub(super) bodies_made: EpochSeen,
-    /// The slots of the bodies that move (awake and not held by `auto`), increasing, as
-    /// `bodies_and_moving` last found them.
-    moving: Vec<u32>,
     pub(super) accelerations: Vec<(Vec2, f64)>,
     pub(super) accelerations_made: EpochSeen,
     /// Empty while the soft step runs (its forces act inside its substeps).
@@ -36,17 +33,10 @@ pub(super) struct SolverInputs {
 }
 
 impl SolverInputs {
-    /// The bodies, and the slots of those that move: the `awake` ones not held.
-    pub(super) fn bodies_and_moving(&mut self, awake: &[u32]) -> BodiesAndMoving<'_> {
-        let bodies = &self.bodies;
-        self.moving.clear();
-        self.moving.extend(
-            awake
-                .iter()
-                .copied()
-                .filter(|&i| bodies[i as usize].moves()),
-        );
-        (&mut self.bodies, &self.moving)
+    /// The bodies, with the slots of those the pass moves (`BodySets::moving`).
+    pub(super) fn bodies_and_moving<'a>(&'a mut self, moving: &'a [u32]) -> BodiesAndMoving<'a> {
+        debug_assert!(moving.iter().all(|&i| self.bodies[i as usize].moves()));
+        (&mut self.bodies, moving)
     }
 }
 
@@ -71,8 +61,11 @@ impl World {
             inputs.bodies.resize(n + 1, SolverBody::default());
         }
         for i in remake {
-            let body = self.bodies[i as usize].as_ref();
-            inputs.bodies[i as usize] = body.map(SolverBody::from_body).unwrap_or_default();
+            inputs.bodies[i as usize] = match self.bodies[i as usize].as_ref() {
+                Some(body) if self.sets.is_held(i) => SolverBody::held_still(body),
+                Some(body) => SolverBody::from_body(body),
+                None => SolverBody::default(),
+            };
         }
         s.joint_constraints.clear();
         for (i, j) in self.joints.iter().enumerate() {
@@ -99,10 +92,10 @@ impl World {
         }
     }
 
-    /// Copies solved velocities and poses (of the bodies the step moves) and motor
+    /// Copies solved velocities and poses (of the bodies the pass moves) and motor
     /// impulses back.
     pub(super) fn scatter_solver_bodies(&mut self) {
-        for &i in self.sets.awake() {
+        for &i in self.sets.moving() {
             let b = self.bodies[i as usize].as_mut().expect("an awake body");
             let solved = &self.inputs.bodies[i as usize];
             b.velocity = solved.velocity;
