@@ -142,9 +142,8 @@ pub struct Body {
     /// call `apply_force_at`) to push the body through the next step.
     pub force: Vec2,
     pub torque: f64,
-    /// Asleep: at rest with its island, skipped by the step until something wakes it.
-    /// An asleep body's inverse mass and inertia are held at 0 so that every stage treats
-    /// it as fixed.
+    /// Asleep: at rest with its island, skipped by the step until something wakes it
+    /// (the world's body sets keep it apart from the bodies a step moves).
     pub(crate) asleep: bool,
     /// How long the body has been slower than the sleep tolerance (s).
     pub(crate) still_time: f64,
@@ -233,27 +232,19 @@ impl Body {
     }
     /// Static, or asleep: the step does not move it.
     pub(crate) fn is_fixed(&self) -> bool {
-        self.inv_mass == 0.0
+        self.is_static() || self.asleep
     }
     pub fn is_asleep(&self) -> bool {
         self.asleep
     }
-    /// Asleep: fixed where it is, still, until woken.
+    /// Asleep: still where it is until woken.
     pub(crate) fn fall_asleep(&mut self) {
         self.asleep = true;
-        self.inv_mass = 0.0;
-        self.inv_inertia = 0.0;
         (self.velocity, self.angular_velocity) = (Vec2::zeros(), 0.0);
     }
     pub(crate) fn wake(&mut self) {
         self.asleep = false;
         self.still_time = 0.0;
-        self.movable_again();
-    }
-    /// The inverse mass and inertia back from the mass properties (see `fall_asleep`).
-    fn movable_again(&mut self) {
-        self.inv_mass = self.inv_mass();
-        self.inv_inertia = self.inv_inertia();
     }
     /// Mass; 0 for a static body (whose mass is really infinite).
     pub fn mass(&self) -> f64 {
@@ -262,21 +253,6 @@ impl Body {
     /// Moment of inertia about the centroid; 0 for a static body.
     pub fn inertia(&self) -> f64 {
         self.inertia
-    }
-    /// 1 / mass; 0 for a static body (also while asleep: the value is the body's own).
-    pub(crate) fn inv_mass(&self) -> f64 {
-        if self.mass > 0.0 {
-            1.0 / self.mass
-        } else {
-            0.0
-        }
-    }
-    pub(crate) fn inv_inertia(&self) -> f64 {
-        if self.inertia > 0.0 {
-            1.0 / self.inertia
-        } else {
-            0.0
-        }
     }
     /// The body's motion as numbers: centroid x and y, angle, velocity x and y, angular
     /// velocity (what a trace compares bit for bit, and what must stay finite).
@@ -354,8 +330,12 @@ impl Body {
         self.torque += cross(world_point - self.position, force);
     }
 
-    /// An impulse at a world point changes the velocities at once (SPEC eq. 5–6).
+    /// An impulse at a world point changes the velocities at once (SPEC eq. 5–6). A
+    /// static or sleeping body takes none: wake it first (`World::wake_body`).
     pub fn apply_impulse_at(&mut self, impulse: Vec2, world_point: Vec2) {
+        if self.is_fixed() {
+            return;
+        }
         self.velocity += impulse * self.inv_mass;
         self.angular_velocity += cross(world_point - self.position, impulse) * self.inv_inertia;
     }
@@ -385,7 +365,7 @@ mod tests {
             let b = Body::new(BodyDef::new(rect(3.0, 1.0), rho)).unwrap();
             assert!((b.mass() - rho * 3.0).abs() < 1e-12);
             assert!((b.inertia() - rho * 3.0 * (9.0 + 1.0) / 12.0).abs() < 1e-12);
-            assert_eq!(b.inv_mass(), 1.0 / b.mass());
+            assert_eq!(b.inv_mass, 1.0 / b.mass());
         }
     }
 
@@ -393,7 +373,7 @@ mod tests {
     fn zero_density_is_static() {
         let b = Body::new(BodyDef::new(rect(3.0, 1.0), 0.0)).unwrap();
         assert!(b.is_static());
-        assert_eq!((b.inv_mass(), b.inv_inertia()), (0.0, 0.0));
+        assert_eq!((b.inv_mass, b.inv_inertia), (0.0, 0.0));
     }
 
     #[test]

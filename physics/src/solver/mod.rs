@@ -30,12 +30,20 @@ pub(crate) struct SolverBody {
 }
 
 impl SolverBody {
+    /// The body as the solvers take it: a sleeping one fixed where it is, with the
+    /// velocity it has (none unless given by hand: then it carries what touches it, as a
+    /// conveyor does).
     pub(crate) fn from_body(body: &Body) -> Self {
+        let (inv_mass, inv_inertia) = if body.is_fixed() {
+            (0.0, 0.0)
+        } else {
+            (body.inv_mass, body.inv_inertia)
+        };
         Self {
             velocity: body.velocity,
             angular_velocity: body.angular_velocity,
-            inv_mass: body.inv_mass,
-            inv_inertia: body.inv_inertia,
+            inv_mass,
+            inv_inertia,
             position: body.position,
             angle: body.angle,
         }

@@ -186,8 +186,7 @@ impl World {
         let kept = &mut self.kept_pairs;
         let n = self.bodies.len();
         let margin = self.settings.contact_margin();
-        let is_fixed =
-            |body: &Option<Body>| body.as_ref().is_none_or(|b| b.is_static() || b.is_asleep());
+        let is_fixed = |body: &Option<Body>| body.as_ref().is_none_or(Body::is_fixed);
         let mut made = self.bounds.make(&self.bodies, &self.sets, dt, margin);
         // The grown bounds' pairs still hold every pair whose bounds overlap now if every
         // body's bounds lie inside its grown ones, and the same bodies are fixed. Bodies

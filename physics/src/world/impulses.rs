@@ -154,7 +154,7 @@ impl World {
             }
             let (ia, ib) = (m.body_a.index(), m.body_b.index());
             let inv_mass = |i: usize| match self.bodies[i].as_ref() {
-                Some(b) if !self.sets.is_held(i as u32) => b.inv_mass,
+                Some(b) if !self.sets.fixed_in_pass(i as u32, b) => b.inv_mass,
                 _ => 0.0,
             };
             let (inv_a, inv_b) = (inv_mass(ia), inv_mass(ib));
