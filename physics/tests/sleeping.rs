@@ -176,12 +176,19 @@ fn a_sleeping_body_takes_no_impulse_and_wakes_with_its_own_mass() {
         assert!(body.is_asleep(), "{solver:?}");
         let centre = body.position;
         body.apply_impulse_at(impulse, centre);
-        assert_eq!(body.velocity, Vec2::zeros(), "{solver:?}: asleep, it took none");
+        assert_eq!(
+            body.velocity,
+            Vec2::zeros(),
+            "{solver:?}: asleep, it took none"
+        );
         w.wake_body(heavy);
         let body = w.body_mut(heavy).unwrap();
         body.apply_impulse_at(impulse, centre);
         assert_eq!(body.velocity, impulse * 0.5, "{solver:?}");
         assert_eq!(body.angular_velocity, 0.0, "{solver:?}");
-        assert!(w.body(boxes[0]).unwrap().is_asleep(), "{solver:?}: the piles sleep on");
+        assert!(
+            w.body(boxes[0]).unwrap().is_asleep(),
+            "{solver:?}: the piles sleep on"
+        );
     }
 }

@@ -1,8 +1,9 @@
-//! The stages of the impulse stage list (`sequential`, `thesis`, `exact`): joint
-//! repair and velocity correction, push-apart, the contact and joint solve, split
-//! impulses, bounces placed at impact, and the state saved to redo a step finer.
+//! The impulse stage list (`sequential`, `thesis`, `exact`, and `auto`'s exact pass) and
+//! its stages: joint repair and velocity correction, push-apart, the contact and joint
+//! solve, split impulses, bounces placed at impact, and the state saved to redo a step
+//! finer.
 
-use super::{MAX_SUBSTEPS, World};
+use super::{Pipeline, World};
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
 use crate::solver::joint::{JointBlockSolver, JointConstraint, JointIterations};
@@ -10,11 +11,56 @@ use crate::solver::simultaneous::FrictionModel;
 use crate::solver::system::VelocityTargets;
 use crate::solver::{BodiesAndMoving, ImpulseMethod};
 
+/// At most this many substeps per step (see `World::substeps_for`).
+const MAX_SUBSTEPS: usize = 8;
+
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
 /// at once overshoots in stacks, where pushes add up along the column.
 const SPLIT_IMPULSE_RATE: f64 = 0.4;
 
 impl World {
+    /// The impulse stage list: joints repaired, then substeps of joint correction,
+    /// forces, contacts, push-apart, the solve and positions; the step taken again with
+    /// finer substeps where a joint's prediction was not to be trusted.
+    pub(super) fn step_impulses(&mut self, method: ImpulseMethod, dt: f64) {
+        self.repair_broken_joints(dt);
+        let mut substeps = self.substeps_for(dt);
+        // A joint still broken is being repaired on purpose over several steps; only
+        // joints that should have closed ask for finer substeps.
+        let repairing = self.max_joint_gap() > self.settings.joint_iterations(dt).broken_gap;
+        loop {
+            self.save_state();
+            let h = dt / substeps as f64;
+            self.for_each_motor(|m| m.step_impulse = 0.0);
+            self.stats.impulse_substeps += substeps as u64;
+            for _ in 0..substeps {
+                self.correct_joint_velocities(h);
+                self.integrate_velocities(h);
+                self.detect_contacts(h, Pipeline::Impulses);
+                self.push_apart(method);
+                self.solve_constraints(method, h);
+                self.place_bounces_at_impact(h);
+                self.integrate_positions(h);
+                self.for_each_motor(|m| {
+                    if m.enabled {
+                        m.step_impulse += m.last_impulse;
+                    }
+                });
+            }
+            // A whip can spin links up within the step; if they now turn too far per
+            // substep, this step's joint prediction was not trustworthy: redo it finer.
+            let mut needed = self.substeps_for(dt);
+            if !repairing && self.max_joint_gap() > 1e-3 * self.settings.length_scale {
+                needed = needed.max(2 * substeps);
+            }
+            if needed <= substeps || substeps >= MAX_SUBSTEPS {
+                break;
+            }
+            self.restore_state();
+            substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
+        }
+    }
+
     pub(super) fn for_each_motor(&mut self, f: impl Fn(&mut JointMotor)) {
         self.joints
             .iter_mut()

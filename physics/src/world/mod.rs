@@ -1,6 +1,7 @@
 //! The world and its step: a list of named stages (SPEC §3.4). This module holds the
-//! world's storage and API and the step's stage lists; each stage's work is in the
-//! module named for it.
+//! world's storage and API and the step's outer stages (`advance`); the solver's stage
+//! list runs in between, `impulses` or `soft_step` (both, under `auto`), and each
+//! stage's work is in the module named for it.
 
 mod auto;
 mod body_sets;
@@ -12,6 +13,7 @@ mod impulses;
 mod integrate;
 pub(crate) mod settings;
 mod sleeping;
+mod soft_step;
 mod solver_bodies;
 pub(crate) mod stats;
 
@@ -29,14 +31,13 @@ use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::ManifoldCache;
 use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon};
 use crate::math::Vec2;
-use crate::solver::contact::{Contact, restitution_threshold};
+use crate::solver::StageList;
+use crate::solver::contact::Contact;
 use crate::solver::island::UnionFind;
 use crate::solver::joint::{Joint, JointBlockSolver, JointConstraint, JointHandle, JointMotor};
 use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
-use crate::solver::soft::{SoftSettings, SoftStepSolver};
-use crate::solver::system::VelocityTargets;
-use crate::solver::{ImpulseMethod, StageList};
+use crate::solver::soft::SoftStepSolver;
 use crate::stage_clock::{self, Stage, StepProfile};
 
 /// A joint to be made: the bodies and the shared world point they pin together, given
@@ -137,9 +138,6 @@ pub enum StepError {
 /// solver let a box through a floor twice its size from 37 length scales a step; every
 /// other solver holds at any gravity within `limits::GRAVITY`).
 pub const FALL_PER_STEP: f64 = 10.0;
-
-/// At most this many substeps per step (see `World::substeps_for`).
-const MAX_SUBSTEPS: usize = 8;
 
 /// A 2D world of rigid convex bodies, pin joints and motors: bodies are added from a
 /// [`BodyDef`], joints from a [`JointDef`], and [`World::step`] advances them all. The
@@ -646,177 +644,6 @@ impl World {
         self.sets.refresh(&self.bodies);
     }
 
-    fn step_impulses(&mut self, method: ImpulseMethod, dt: f64) {
-        self.repair_broken_joints(dt);
-        let mut substeps = self.substeps_for(dt);
-        // A joint still broken is being repaired on purpose over several steps; only
-        // joints that should have closed ask for finer substeps.
-        let repairing = self.max_joint_gap() > self.settings.joint_iterations(dt).broken_gap;
-        loop {
-            self.save_state();
-            let h = dt / substeps as f64;
-            self.for_each_motor(|m| m.step_impulse = 0.0);
-            self.stats.impulse_substeps += substeps as u64;
-            for _ in 0..substeps {
-                self.correct_joint_velocities(h);
-                self.integrate_velocities(h);
-                self.detect_contacts(h, Pipeline::Impulses);
-                self.push_apart(method);
-                self.solve_constraints(method, h);
-                self.place_bounces_at_impact(h);
-                self.integrate_positions(h);
-                self.for_each_motor(|m| {
-                    if m.enabled {
-                        m.step_impulse += m.last_impulse;
-                    }
-                });
-            }
-            // A whip can spin links up within the step; if they now turn too far per
-            // substep, this step's joint prediction was not trustworthy: redo it finer.
-            let mut needed = self.substeps_for(dt);
-            if !repairing && self.max_joint_gap() > 1e-3 * self.settings.length_scale {
-                needed = needed.max(2 * substeps);
-            }
-            if needed <= substeps || substeps >= MAX_SUBSTEPS {
-                break;
-            }
-            self.restore_state();
-            substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
-        }
-    }
-
-    /// The soft step has its own stage list: forces, contacts found once, then substeps
-    /// that integrate and solve together (see `solver::soft`).
-    fn step_soft(&mut self, dt: f64) {
-        self.inputs.start_velocities.clear(); // forces act inside the substeps
-        self.detect_contacts(dt, Pipeline::Soft);
-        // The soft step pulls every pin closed its own way: no repair targets.
-        self.gather_solver_bodies_with(GapTargets::None);
-        // Zero but for the bodies the step moves (the ground's, last, among the zeros).
-        let inputs = &mut self.inputs;
-        let n = self.bodies.len();
-        let whole = inputs.accelerations.len() == n + 1;
-        let remake = self
-            .sets
-            .to_remake(&mut inputs.accelerations_made, whole, n);
-        if remake.every() {
-            inputs.accelerations.clear();
-            inputs.accelerations.resize(n + 1, (Vec2::zeros(), 0.0));
-        }
-        for i in remake {
-            inputs.accelerations[i as usize] = match &self.bodies[i as usize] {
-                Some(b) if !self.sets.fixed_in_pass(i, b) => (
-                    self.gravity + b.force * b.inv_mass,
-                    b.torque * b.inv_inertia,
-                ),
-                _ => (Vec2::zeros(), 0.0),
-            };
-        }
-        // The impact pass runs only where two moving bodies may bounce (a pile of cor 0
-        // pays one look at its contacts). Two that meet within the step sooner than their
-        // velocities at its start foretold (a pendulum speeding up through its pin) would
-        // bounce in the soft step's own restitution, which shares the impulse: the step is
-        // taken again with the impact pass bouncing those pairs too.
-        let bodies = &self.inputs.bodies;
-        let moves = |i: u32| bodies[i as usize].moves();
-        let may_bounce = self.settings.propagate_impacts
-            && self
-                .contacts
-                .iter()
-                .any(|c| c.restitution > 0.0 && moves(c.body_a.0) && moves(c.body_b.0));
-        let found = may_bounce.then(|| self.contacts.clone());
-        let mut unforeseen = Vec::new();
-        loop {
-            if may_bounce {
-                self.propagate_impacts_before_soft_step(dt, &unforeseen);
-            }
-            let s = &mut self.scratch;
-            if !self.solvers.soft_seen.sets_changed(&self.sets) {
-                self.solvers.soft.bodies_changed_only(self.sets.awake());
-            }
-            self.solvers.soft.step(
-                &SoftSettings {
-                    substeps: self.settings.soft_substeps.max(1),
-                    alternating_sweeps: self.settings.soft_alternating_sweeps,
-                    ..SoftSettings::for_length_scale(self.settings.length_scale)
-                },
-                &mut self.inputs.bodies,
-                &self.inputs.accelerations,
-                &mut self.contacts,
-                &mut s.joint_constraints,
-                dt,
-                restitution_threshold(self.gravity, dt),
-            );
-            let Some(found) = found.as_ref().filter(|_| unforeseen.is_empty()) else {
-                break;
-            };
-            unforeseen = self.unforeseen_impacts(dt);
-            if unforeseen.is_empty() {
-                break;
-            }
-            self.contacts.clone_from(found);
-            self.gather_solver_bodies_with(GapTargets::None);
-        }
-        self.scatter_solver_bodies();
-    }
-
-    /// The body pairs that the soft step bounced between two moving bodies: pairs that
-    /// met within the step, which the impact pass did not foresee.
-    fn unforeseen_impacts(&self, dt: f64) -> Vec<(u32, u32)> {
-        let bounce_below = restitution_threshold(self.gravity, dt);
-        let bodies = &self.inputs.bodies;
-        let moves = |i: u32| bodies[i as usize].moves();
-        let mut pairs: Vec<(u32, u32)> = self
-            .contacts
-            .iter()
-            .filter(|c| {
-                c.restitution > 0.0
-                    && c.approach_velocity <= -bounce_below
-                    && c.normal_impulse > 0.0
-                    && moves(c.body_a.0)
-                    && moves(c.body_b.0)
-            })
-            .map(|c| (c.body_a.0, c.body_b.0))
-            .collect();
-        pairs.dedup();
-        pairs
-    }
-
-    /// The impact pass (`SimultaneousSolver::propagate_all_impacts`) before the soft step,
-    /// which then bounces only what the pass left.
-    /// `unforeseen`: pairs to bounce as meeting this step whatever their velocities say.
-    fn propagate_impacts_before_soft_step(&mut self, dt: f64, unforeseen: &[(u32, u32)]) {
-        let s = &mut self.scratch;
-        // The soft step's contacts carry the velocities of the step's start; whether
-        // a pair meets this step also takes the step's forces (as `exact`'s do).
-        for c in self.contacts.iter_mut() {
-            let (a, b) = (c.body_a.index(), c.body_b.index());
-            let kick = (self.inputs.accelerations[a].0 - self.inputs.accelerations[b].0)
-                .dot(&c.normal)
-                * dt;
-            c.normal_velocity = c.approach_velocity + kick;
-            if c.depth < 0.0 && unforeseen.contains(&(c.body_a.0, c.body_b.0)) {
-                // Closing twice the gap within the step: the pair meets.
-                c.normal_velocity = c.normal_velocity.min(2.0 * c.depth / dt);
-            }
-        }
-        self.solvers.exact.dense_row_limit = self.settings.dense_row_limit;
-        self.solvers.exact.propagate_all_impacts(
-            &mut self.contacts,
-            &s.joint_constraints,
-            self.inputs.bodies_and_moving(self.sets.moving()),
-            &VelocityTargets {
-                dt,
-                bounce_below: restitution_threshold(self.gravity, dt),
-                friction: true,
-                close_joint_gaps: false,
-            },
-        );
-        for c in self.contacts.iter_mut() {
-            c.normal_velocity = c.approach_velocity;
-        }
-    }
-
     /// The clock's ticks each stage of the last step took: see [`StepProfile`]. Counted
     /// with the feature `stage-clock` only; all zero without it.
     pub fn profile(&self) -> &StepProfile {
@@ -850,76 +677,6 @@ mod tests {
     use super::*;
     use crate::shape::ConvexPolygon;
     use crate::solver::ContactSolver;
-
-    /// A manifold that goes into the kept plan's lanes is not written to the soft step's
-    /// points; when the plan changes after all, or something bounces, they are built
-    /// again. A pile stepped so must move exactly as one whose every point is written,
-    /// through a box landing on it (the plan changes) and one bouncing on its top box
-    /// (restitution is the smaller of the two bodies': only the top box has any).
-    #[test]
-    fn points_left_unwritten_change_no_step() {
-        let (h, rows) = (1.0 / 60.0, 8);
-        let pile = |write_every_point| {
-            let mut world = World::new(Vec2::new(0.0, 10.0));
-            world.settings.contact_solver = ContactSolver::Soft;
-            world.friction = 0.6;
-            let floor = ConvexPolygon::rectangle(40.0, 1.0).unwrap();
-            world
-                .add_body(BodyDef::new(floor, 0.0).at(Vec2::new(0.0, 0.5), 0.0))
-                .unwrap();
-            let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-            for row in 0..rows {
-                for i in 0..rows - row {
-                    let x = i as f64 - 0.5 * (rows - 1 - row) as f64;
-                    let centre = Vec2::new(x, -0.5 - row as f64);
-                    let def = BodyDef::new(unit.clone(), 1.0).at(centre, 0.0);
-                    let top = row == rows - 1;
-                    world
-                        .add_body(if top { def.restitution(0.5) } else { def })
-                        .unwrap();
-                }
-            }
-            world.solvers.soft.write_every_point = write_every_point;
-            world
-        };
-        let (mut skipping, mut writing) = (pile(false), pile(true));
-        let unit = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-        for step in 0..300 {
-            let dropped = match step {
-                90 => Some((BodyDef::new(unit.clone(), 1.0), -3.0)),
-                180 => Some((BodyDef::new(unit.clone(), 1.0).restitution(0.5), 0.1)),
-                _ => None,
-            };
-            if let Some((def, x)) = dropped {
-                let def = def.at(Vec2::new(x, -(rows as f64) - 3.0), 0.1);
-                skipping.add_body(def.clone()).unwrap();
-                writing.add_body(def).unwrap();
-            }
-            skipping.step(h);
-            writing.step(h);
-            let bits = |w: &World| -> Vec<u64> {
-                w.bodies()
-                    .flat_map(|(_, b)| b.state())
-                    .map(f64::to_bits)
-                    .collect()
-            };
-            assert_eq!(bits(&skipping), bits(&writing), "step {step}");
-        }
-        let stats = skipping.stats();
-        let (skipped, rebuilt) = (
-            stats.soft_steps_skipping_points,
-            stats.soft_steps_rebuilding_points,
-        );
-        assert!(skipped > 200, "{skipped} steps left points unwritten");
-        // The landing's step or two, and every step from the bouncing box's first
-        // contact on.
-        assert!(
-            (50..150).contains(&rebuilt),
-            "{rebuilt} built their points again"
-        );
-        assert_eq!(writing.stats().soft_steps_skipping_points, 0);
-        assert_eq!(writing.stats().soft_steps_rebuilding_points, 0);
-    }
 
     /// Every pair of bodies, not both fixed, whose bounds overlap now: what the broad
     /// phase must find, by comparing every pair.
