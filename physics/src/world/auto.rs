@@ -2,7 +2,10 @@
 //! its part of the awake set and holding the other's bodies still (`BodySets`).
 
 use super::World;
+use crate::collide::Manifold;
 use crate::solver::ImpulseMethod;
+use crate::solver::contact::Contact;
+use crate::solver::island::UnionFind;
 use crate::solver::simultaneous::IslandReport;
 
 /// Seconds an island that went over the exact solver's pivot budget stays on the soft
@@ -30,14 +33,31 @@ pub(super) struct LastMarking {
     fixed: Vec<bool>,
     row_limit: usize,
     prefer_soft: Vec<bool>,
+    /// Per slot: whether the body is a moving one in an island of the soft step's.
+    in_soft_island: Vec<bool>,
     /// `(exact, soft)`: whether some moving body is in an exact island, some in a soft
     /// one.
     found: Option<(bool, bool)>,
 }
 
+/// `auto`'s buffers, reused from step to step: the islands' links, union-find, row
+/// counts and needs, the bodies kept on the soft step this step, and the exact pass's
+/// contacts and manifolds while the soft pass runs.
+#[derive(Debug, Clone, Default)]
+pub(super) struct AutoScratch {
+    links: Vec<(u32, u32, usize)>,
+    island_union: UnionFind,
+    island_rows: Vec<usize>,
+    island_needs: Vec<IslandNeeds>,
+    /// Per body: whether it is kept on the soft step this step (`AutoMemory::soft_until`).
+    prefer_soft: Vec<bool>,
+    exact_contacts: Vec<Contact>,
+    exact_manifolds: Vec<Manifold>,
+}
+
 /// What an island holds that decides whether `auto` solves it exactly.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct IslandNeeds {
+struct IslandNeeds {
     /// A pin or a motor.
     jointed: bool,
     /// The heaviest and the lightest moving body's inverse mass (the smallest and the
@@ -110,13 +130,13 @@ impl World {
         self.step_impulses(ImpulseMethod::Exact, dt);
         self.release_held();
         self.keep_over_budget_on_soft(dt);
-        let s = &mut self.scratch;
+        let s = &mut self.scratch.auto;
         std::mem::swap(&mut s.exact_contacts, &mut self.contacts);
         std::mem::swap(&mut s.exact_manifolds, &mut self.manifolds);
         self.hold_where(false);
         self.step_soft(dt);
         self.release_held();
-        let s = &mut self.scratch;
+        let s = &mut self.scratch.auto;
         self.auto.reports.clone_from(&self.solvers.exact.reports);
         self.auto
             .reports
@@ -153,8 +173,8 @@ impl World {
         let n = self.bodies.len();
         let bodies = &self.bodies;
         let moving = |i: u32| bodies[i as usize].as_ref().is_some_and(|b| !b.is_fixed());
-        let s = &mut self.scratch;
-        let mut links: Vec<(u32, u32, usize)> = std::mem::take(&mut s.auto_links);
+        let (pairs, s) = (&self.scratch.pairs, &mut self.scratch.auto);
+        let mut links: Vec<(u32, u32, usize)> = std::mem::take(&mut s.links);
         links.clear();
         links.extend(self.contacts.iter().map(|c| (c.body_a.0, c.body_b.0, 2)));
         let contact_links = links.len();
@@ -179,15 +199,15 @@ impl World {
         let last = &self.auto.last_marking;
         if let Some(marked) = last.found
             && (&last.links, &last.candidates, &last.fixed, last.row_limit)
-                == (&links, &s.pairs, &self.kept_pairs.fixed, limit)
+                == (&links, pairs, &self.kept_pairs.fixed, limit)
             && last.prefer_soft == s.prefer_soft
         {
-            s.auto_links = links;
+            s.links = links;
             self.stats.auto_splits_kept += 1;
             return marked;
         }
         s.island_union.reset(n);
-        let candidates = s.pairs.iter().map(|&(a, b)| (a, b, 0));
+        let candidates = pairs.iter().map(|&(a, b)| (a, b, 0));
         for (a, b, _) in links.iter().copied().chain(candidates) {
             if moving(a) && moving(b) {
                 s.island_union.union(a, b);
@@ -201,7 +221,7 @@ impl World {
             let columns = if k < contact_links { 0..1 } else { 0..2 };
             (a, b, rows, columns)
         });
-        let candidates = s.pairs.iter().map(|&(a, b)| (a, b, 2, 1..2));
+        let candidates = pairs.iter().map(|&(a, b)| (a, b, 2, 1..2));
         for (a, b, rows, columns) in counted.chain(candidates) {
             let end = if moving(a) { a } else { b };
             if moving(end) {
@@ -231,8 +251,9 @@ impl World {
                 needs.prefers_soft |= s.prefer_soft[i as usize];
             }
         }
-        s.auto_links = links;
-        s.in_soft_island.clear();
+        s.links = links;
+        let last = &mut self.auto.last_marking;
+        last.in_soft_island.clear();
         let (mut exact, mut soft) = (false, false);
         for i in 0..n as u32 {
             let root = s.island_union.find(i) as usize;
@@ -240,14 +261,13 @@ impl World {
             let needs = &s.island_needs[root];
             let goes_exact = needs.exact_needed() && rows <= limit && !needs.kept_on_soft();
             let in_soft = moving(i) && !goes_exact;
-            s.in_soft_island.push(in_soft);
+            last.in_soft_island.push(in_soft);
             soft |= in_soft;
             exact |= moving(i) && goes_exact;
         }
-        let last = &mut self.auto.last_marking;
         // The last links go back to be the buffer for the next marking's.
-        std::mem::swap(&mut last.links, &mut s.auto_links);
-        last.candidates.clone_from(&s.pairs);
+        std::mem::swap(&mut last.links, &mut s.links);
+        last.candidates.clone_from(pairs);
         last.fixed.clone_from(&self.kept_pairs.fixed);
         last.row_limit = limit;
         last.prefer_soft.clone_from(&s.prefer_soft);
@@ -275,7 +295,7 @@ impl World {
     /// Starts a pass that holds every awake body whose island is (`soft`) or is not
     /// (`!soft`) the soft step's.
     fn hold_where(&mut self, soft: bool) {
-        let in_soft_island = &self.scratch.in_soft_island;
+        let in_soft_island = &self.auto.last_marking.in_soft_island;
         let held = |i: u32| in_soft_island[i as usize] == soft;
         self.sets.hold_for_pass(self.bodies.len(), held);
     }
@@ -420,11 +440,14 @@ mod tests {
                 _ => {}
             }
             let kept = world.mark_soft_islands(dt);
-            let kept_marks = world.scratch.in_soft_island.clone();
+            let kept_marks = world.auto.last_marking.in_soft_island.clone();
             world.auto.last_marking.found = None;
             let fresh = world.mark_soft_islands(dt);
             assert_eq!(kept, fresh, "step {step}");
-            assert_eq!(kept_marks, world.scratch.in_soft_island, "step {step}");
+            assert_eq!(
+                kept_marks, world.auto.last_marking.in_soft_island,
+                "step {step}"
+            );
             world.step(dt);
         }
         let asleep = world.bodies().filter(|(_, b)| b.is_asleep()).count();

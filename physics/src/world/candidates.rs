@@ -4,7 +4,7 @@
 
 use super::World;
 use crate::body::Body;
-use crate::collide::{Aabb, FixedCells};
+use crate::collide::{Aabb, BroadPhase, FixedCells};
 use crate::solver::island::merged_increasing;
 
 /// While the broad phase pairs the bodies again every time, every this many pairings use
@@ -46,9 +46,20 @@ fn crowded(pairs: &[(u32, u32)], fixed: &[bool], radii: &[f64], room_taken: &mut
     crowded
 }
 
+/// The broad phase's buffers, reused from step to step: its own, each body's bounding
+/// radius, and what keeping a crowded body's nearest neighbours takes
+/// (`KeptPairs::crowded`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct CandidateScratch {
+    broad_phase: BroadPhase,
+    radii: Vec<f64>,
+    grown_by: Vec<f64>,
+    neighbours: NeighbourScratch,
+}
+
 /// Scratch for `keep_nearest_neighbours`.
 #[derive(Debug, Clone, Default)]
-pub(super) struct NeighbourScratch {
+struct NeighbourScratch {
     room_taken: Vec<f64>,
     dropped: Vec<bool>,
     /// (gap, pair) for the pairs found only by how far their bodies can move.
@@ -237,7 +248,9 @@ impl World {
             fixed_slots.clear();
             fixed_slots.extend(merged_increasing(self.sets.statics(), self.sets.sleeping()));
             if fixed_slots.len() < FIXED_CELLS_FROM {
-                s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
+                s.candidates
+                    .broad_phase
+                    .pairs(&kept.bounds, wanted, &mut kept.pairs);
             } else {
                 let listed_with = (made_for, grow.to_bits());
                 if kept.fixed_cells_for != Some(listed_with) {
@@ -245,20 +258,21 @@ impl World {
                     kept.fixed_cells_for = Some(listed_with);
                 }
                 let moving = self.sets.awake();
-                s.broad_phase
+                s.candidates
+                    .broad_phase
                     .pairs_among(&kept.bounds, moving, wanted, &mut kept.pairs);
                 kept.fixed_cells
                     .pairs_with(&kept.bounds, moving, wanted, &mut kept.pairs);
-                s.broad_phase.sort_pairs(&mut kept.pairs, n);
+                s.candidates.broad_phase.sort_pairs(&mut kept.pairs, n);
             }
-            s.radii.clear();
-            s.radii.extend(
+            s.candidates.radii.clear();
+            s.candidates.radii.extend(
                 bodies
                     .iter()
                     .map(|b| b.as_ref().map_or(0.0, Body::bounding_radius)),
             );
-            let room_taken = &mut s.neighbours.room_taken;
-            kept.crowded = crowded(&kept.pairs, fixed, &s.radii, room_taken);
+            let room_taken = &mut s.candidates.neighbours.room_taken;
+            kept.crowded = crowded(&kept.pairs, fixed, &s.candidates.radii, room_taken);
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
         let boxes = &bounds.boxes;
@@ -282,11 +296,21 @@ impl World {
             s.pairs.extend(kept.pairs.iter().copied().filter(overlap));
         }
         if kept.crowded {
-            s.grown_by.clear();
-            s.grown_by
+            s.candidates.grown_by.clear();
+            s.candidates
+                .grown_by
                 .extend(bounds.reach.iter().map(|reach| 0.5 * margin + reach));
-            let sizes = (&bounds.boxes[..], &s.grown_by[..], &s.radii[..]);
-            keep_nearest_neighbours(&mut s.pairs, &kept.fixed, sizes, &mut s.neighbours);
+            let sizes = (
+                &bounds.boxes[..],
+                &s.candidates.grown_by[..],
+                &s.candidates.radii[..],
+            );
+            keep_nearest_neighbours(
+                &mut s.pairs,
+                &kept.fixed,
+                sizes,
+                &mut s.candidates.neighbours,
+            );
         }
     }
 }

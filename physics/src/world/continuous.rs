@@ -6,6 +6,25 @@ use super::body_sets::{BodySets, EpochSeen};
 use crate::body::Body;
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
 use crate::collide::{Aabb, WorldPolygon};
+use crate::math::Vec2;
+use crate::solver::island::UnionFind;
+
+/// Continuous collision's buffers, reused from step to step.
+#[derive(Debug, Clone, Default)]
+pub(super) struct ContinuousScratch {
+    /// By slot, each awake body's centroid and angle when the step began.
+    pub(super) step_start: Vec<(Vec2, f64)>,
+    /// The moving body's outline where its step ends and starts, and the time-of-impact
+    /// search's own.
+    mover_at_end: WorldPolygon,
+    mover_at_start: WorldPolygon,
+    toi_scratch: WorldPolygon,
+    /// The bodies stopped and their times of impact; joint islands and each island's
+    /// earliest impact.
+    impacts: Vec<(u32, f64)>,
+    impact_union: UnionFind,
+    island_impact: Vec<f64>,
+}
 
 /// The static bodies as obstacles, kept while the sets stay: each one's slot, outline,
 /// bounds and place, and an index of them by their bounds' left edge, for finding those
@@ -107,7 +126,7 @@ impl World {
     pub(super) fn stop_at_impact(&mut self) {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
-        let s = &mut self.scratch;
+        let s = &mut self.scratch.continuous;
         // The static bodies, looked at when the first body needs them (most steps, none
         // does), and listed again only if the sets changed.
         let mut obstacles = std::mem::take(&mut self.obstacles);
@@ -225,7 +244,7 @@ impl World {
     /// rest of the step's motion. (Turning bodies' pins then stay together to second order
     /// in the step's rotation; the joint passes close the rest next step.)
     fn move_back_to_impacts(&mut self) {
-        let s = &mut self.scratch;
+        let s = &mut self.scratch.continuous;
         if s.impacts.is_empty() {
             return;
         }

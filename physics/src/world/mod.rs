@@ -19,21 +19,21 @@ pub(crate) mod stats;
 
 use settings::{Integrator, StepSettings};
 
-use auto::{AutoMemory, IslandNeeds};
+use auto::{AutoMemory, AutoScratch};
 use body_sets::{BodySets, EpochSeen};
 use bounds::BodyBounds;
-use candidates::{KeptPairs, NeighbourScratch};
-use continuous::Obstacles;
+use candidates::{CandidateScratch, KeptPairs};
+use continuous::{ContinuousScratch, Obstacles};
+use sleeping::SleepScratch;
 use solver_bodies::{GapTargets, SolverInputs};
 use stats::StepStats;
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::ManifoldCache;
-use crate::collide::{Aabb, BroadPhase, Manifold, PairSet, WorldPolygon};
+use crate::collide::{Manifold, PairSet};
 use crate::math::Vec2;
 use crate::solver::StageList;
 use crate::solver::contact::Contact;
-use crate::solver::island::UnionFind;
 use crate::solver::joint::{Joint, JointBlockSolver, JointConstraint, JointHandle, JointMotor};
 use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
@@ -236,26 +236,17 @@ struct Solvers {
     soft_seen: EpochSeen,
 }
 
-/// Buffers reused from step to step so that stepping does not allocate.
+/// Buffers reused from step to step so that stepping does not allocate: the step's
+/// candidate pairs and the solvers' joint rows, which several stages read, and each
+/// stage's own buffers.
 #[derive(Debug, Clone, Default)]
 struct Scratch {
-    /// Islands of bodies, for sleeping and for `auto`'s choice of solver.
-    island_union: UnionFind,
-    wake_labels: Vec<u32>,
-    wake_broad_phase: BroadPhase,
-    /// Waking's own bounding boxes and reaches by slot (its broad phase's), and the
-    /// slots boxed.
-    wake_boxes: Vec<Option<Aabb>>,
-    wake_reach: Vec<f64>,
-    wake_slots: Vec<u32>,
-    island_ready: Vec<bool>,
-    broad_phase: BroadPhase,
+    /// The step's candidate pairs (`find_candidate_pairs`).
     pairs: Vec<(u32, u32)>,
-    /// Each body's bounding radius, and scratch for keeping a crowded body's nearest
-    /// neighbours (`KeptPairs::crowded`).
-    radii: Vec<f64>,
-    grown_by: Vec<f64>,
-    neighbours: NeighbourScratch,
+    /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
+    /// the next contact detection at the same step length: set by `auto` only.
+    candidates_current: bool,
+    candidates: CandidateScratch,
     /// This step's manifolds' gaps less what their bodies can close of them, and how far
     /// a collision may turn each body off its course (`drop_idle_manifolds`).
     gaps: Vec<f64>,
@@ -263,32 +254,9 @@ struct Scratch {
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
     joint_constraints: Vec<JointConstraint>,
-    /// By slot, each awake body's centroid and angle when the step began, for continuous
-    /// collision.
-    step_start: Vec<(Vec2, f64)>,
-    /// Continuous collision: the moving body's outline where its step ends and starts,
-    /// and the time-of-impact search's own.
-    mover_at_end: WorldPolygon,
-    mover_at_start: WorldPolygon,
-    toi_scratch: WorldPolygon,
-    /// Continuous collision: the bodies stopped and their times of impact; joint islands
-    /// and each island's earliest impact.
-    impacts: Vec<(u32, f64)>,
-    impact_union: UnionFind,
-    island_impact: Vec<f64>,
-    /// `auto`: the islands' links and row counts, which bodies are in the soft step's
-    /// islands, and the exact pass's contacts while the soft pass runs.
-    auto_links: Vec<(u32, u32, usize)>,
-    island_rows: Vec<usize>,
-    island_needs: Vec<IslandNeeds>,
-    /// Per body: whether it is kept on the soft step this step (`AutoMemory::soft_until`).
-    prefer_soft: Vec<bool>,
-    in_soft_island: Vec<bool>,
-    exact_contacts: Vec<Contact>,
-    exact_manifolds: Vec<Manifold>,
-    /// `pairs` (and outlines, reaches, poses) are those of the bodies as they are now, for
-    /// the next contact detection at the same step length: set by `auto` only.
-    candidates_current: bool,
+    sleeping: SleepScratch,
+    continuous: ContinuousScratch,
+    auto: AutoScratch,
 }
 
 impl World {
@@ -613,7 +581,7 @@ impl World {
         self.sets.refresh(&self.bodies);
         if self.settings.continuous {
             // Read for the awake bodies only.
-            let start = &mut self.scratch.step_start;
+            let start = &mut self.scratch.continuous.step_start;
             start.resize(self.bodies.len(), (Vec2::zeros(), 0.0));
             for &i in self.sets.awake() {
                 let b = self.bodies[i as usize].as_ref().expect("an awake body");
@@ -675,6 +643,7 @@ impl World {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::collide::Aabb;
     use crate::shape::ConvexPolygon;
     use crate::solver::ContactSolver;
 

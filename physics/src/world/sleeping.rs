@@ -3,9 +3,27 @@
 
 use super::World;
 use crate::body::{Body, BodyHandle};
-use crate::collide::Aabb;
+use crate::collide::{Aabb, BroadPhase};
 use crate::math::Vec2;
-use crate::solver::island::merged_increasing;
+use crate::solver::island::{UnionFind, merged_increasing};
+
+/// Sleeping's and waking's buffers, reused from step to step.
+#[derive(Debug, Clone, Default)]
+pub(super) struct SleepScratch {
+    /// The islands to wake.
+    wake_labels: Vec<u32>,
+    /// Waking's own broad phase, its bounding boxes and reaches by slot, the slots boxed
+    /// and the pairs found.
+    wake_broad_phase: BroadPhase,
+    wake_boxes: Vec<Option<Aabb>>,
+    wake_reach: Vec<f64>,
+    wake_slots: Vec<u32>,
+    wake_pairs: Vec<(u32, u32)>,
+    /// The islands of the bodies still awake at the step's end, and whether each may
+    /// sleep.
+    island_union: UnionFind,
+    island_ready: Vec<bool>,
+}
 
 /// Seconds an island must stay still before it sleeps.
 const SLEEP_AFTER: f64 = 0.5;
@@ -39,7 +57,7 @@ impl World {
     /// each other, not awake × asleep.
     pub(super) fn wake_where_needed(&mut self, dt: f64) {
         let margin = self.settings.contact_margin();
-        let mut wake = std::mem::take(&mut self.scratch.wake_labels);
+        let mut wake = std::mem::take(&mut self.scratch.sleeping.wake_labels);
         wake.clear();
         self.sets.refresh(&self.bodies);
         let (some_asleep, some_awake) = self.sets.some_asleep_and_awake();
@@ -52,7 +70,7 @@ impl World {
             };
             // Boxes for the bodies that can move, asleep or awake, by slot (the static
             // ones take no part).
-            let s = &mut self.scratch;
+            let s = &mut self.scratch.sleeping;
             let n = self.bodies.len();
             s.wake_boxes.resize(n, None);
             s.wake_reach.resize(n, 0.0);
@@ -75,8 +93,8 @@ impl World {
             let asleep = |i: usize| bodies[i].as_ref().is_some_and(|b| b.asleep);
             let wanted = |i, j| asleep(i) != asleep(j);
             s.wake_broad_phase
-                .pairs_among(&s.wake_boxes, &s.wake_slots, wanted, &mut s.pairs);
-            for &(i, j) in &s.pairs {
+                .pairs_among(&s.wake_boxes, &s.wake_slots, wanted, &mut s.wake_pairs);
+            for &(i, j) in &s.wake_pairs {
                 let (sleeper, awake) = if asleep(i as usize) { (i, j) } else { (j, i) };
                 let (b, a) = (
                     bodies[sleeper as usize].as_ref().expect("boxed"),
@@ -109,7 +127,7 @@ impl World {
         for &label in &wake {
             self.wake_island(label);
         }
-        self.scratch.wake_labels = wake;
+        self.scratch.sleeping.wake_labels = wake;
     }
 
     /// Times how long each awake body has been still, and puts to sleep the islands whose
@@ -129,7 +147,7 @@ impl World {
         let moving = |bodies: &[Option<Body>], i: u32| {
             bodies[i as usize].as_ref().is_some_and(|b| !b.is_fixed())
         };
-        let uf = &mut self.scratch.island_union;
+        let uf = &mut self.scratch.sleeping.island_union;
         uf.reset(n);
         for c in &self.contacts {
             if moving(&self.bodies, c.body_a.0) && moving(&self.bodies, c.body_b.0) {
@@ -146,7 +164,7 @@ impl World {
         }
         // An island may sleep when its stillest-to-be body has waited long enough and no
         // motor in it runs.
-        let mut ready = std::mem::take(&mut self.scratch.island_ready);
+        let mut ready = std::mem::take(&mut self.scratch.sleeping.island_ready);
         ready.clear();
         ready.resize(n, true);
         for &i in self.sets.awake() {
@@ -183,6 +201,6 @@ impl World {
         if some_fell_asleep {
             self.sets.mark_changed();
         }
-        self.scratch.island_ready = ready;
+        self.scratch.sleeping.island_ready = ready;
     }
 }
