@@ -1,8 +1,8 @@
 //! The largest magnitude each kind of number may have in a world. They are far beyond
 //! anything a robot or a benchmark needs (issue 9's extreme-but-legal input: coordinates
 //! of 1e6, density ratios of 1e6, torques of 1e12) and far below where a step overflows:
-//! the fuzzer found that a gravitation of 1e308 or a motor torque of 1e300 passed the
-//! finiteness checks and turned the first step to infinity. Bodies, joints, motors and
+//! a finite gravitation of 1e308 or motor torque of 1e300 turns the first step to
+//! infinity, so finiteness alone is not enough. Bodies, joints, motors and
 //! steps beyond them are refused with an error naming the number.
 
 /// Positions, anchors and polygon vertices (length units).

@@ -189,9 +189,8 @@ impl BroadPhase {
                     // cells, paired in one only: the cell of their overlap's lower corner,
                     // which both cover. Within a bucket the entries are in body order: i < j.
                     // The tests are combined without branching, and the pair written and
-                    // kept or dropped: each goes either way from pair to pair, and taken one
-                    // by one as branches they cost more (the smash's grid: 8.25M cycles a
-                    // step, 6.8M this way).
+                    // kept or dropped: each goes either way from pair to pair, so branches
+                    // on them are mispredicted often and cost more.
                     let found = (other_cell == cell)
                         & ((xi.max(xj), yi.max(yj)) == cell)
                         & bi.overlaps(&bj);

@@ -41,8 +41,8 @@ impl ContactMemory {
     /// The last impulses of `contact`, the `k`-th of this step's contacts, if the `k`-th
     /// entry is its own, as it is where no contact came or went before it, or if one of
     /// its neighbours is: a manifold's two points may come in the other order than last
-    /// step's (large_pyramid had such a swap somewhere in half its steps at rest, and
-    /// each cost a `recall` of all 30,000 contacts). A key is a contact's alone, so the
+    /// step's (a big pile at rest has such a swap somewhere in many of its steps, and a
+    /// miss costs a `recall` of every contact). A key is a contact's alone, so the
     /// entry found is the one `recall` finds. `None` says only that this guess missed
     /// (`recall` finds them all).
     #[inline]

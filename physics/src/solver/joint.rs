@@ -358,9 +358,9 @@ fn own_block(j: &JointConstraint, bodies: &[SolverBody], ahead: f64) -> [[f64; 2
 
 /// The repair moves bodies by the smallest mass-weighted displacement, with rotations
 /// made this much costlier than physics would weigh them. A thin link's small inertia
-/// would otherwise let the first-order solve turn links by radians to save a little
-/// translation (measured: a 40-link chain stretched straight turns links 900 rad and the
-/// Newton steps stall); translations enter the gaps linearly, so a chain or tree closes
+/// would otherwise let the first-order solve turn links by whole turns to save a little
+/// translation, and the Newton steps stall; translations enter the gaps linearly, so a
+/// chain or tree closes
 /// in one step, and rotation is still used where a closed loop needs it.
 const REPAIR_ROTATION_WEIGHT: f64 = 1e-4;
 

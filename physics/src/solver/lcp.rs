@@ -193,8 +193,8 @@ impl LcpSolver {
     /// Solves a problem with the same `A` as the last one this solver solved and another
     /// `b` (the soft step's passes after its first): the first round starts from the last
     /// solution's sets and the factor of their `A_CC`, and pivots only if they do not
-    /// solve it. The residual is not computed: it took 3% of the soft step's time in the
-    /// random throws (`physics/tests/support/random_throws.rs`).
+    /// solve it. The residual is not computed: in small worlds it is a few percent of the
+    /// soft step's time, for a check the pivoting already makes.
     pub(crate) fn solve_again(&mut self, p: &LcpProblem, x: &mut Vec<f64>) -> LcpStats {
         let warm = self.sets_valid && self.b.len() == p.n;
         self.solve_from(p, x, warm, &[])
@@ -247,8 +247,8 @@ impl LcpSolver {
         let mut method = LcpMethod::Pivoting;
         // A guess gives the first round's sets too; `solve_again` keeps the last ones.
         // Where there is no guess, equality rows (pins) are clamped in every solution: a
-        // chain of pins then costs one factorisation, not a pivot per row (a 40-link
-        // chain's 82 rows took 2.5 ms a step by pivoting).
+        // chain of pins then costs one factorisation, not a pivot per row (milliseconds a
+        // step for a 40-link chain).
         let has_equality_rows =
             (0..n).any(|i| p.lo[i] == f64::NEG_INFINITY && p.hi[i] == f64::INFINITY);
         let guessed = guess.len() == n || (guess.is_empty() && has_equality_rows);

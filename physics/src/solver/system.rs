@@ -146,8 +146,7 @@ pub(crate) fn velocity_rows(
             // Two points on one face have the same tangent row but for the lever, which
             // differs only by the points' offset along the normal (their depths): one row
             // at their midpoint, bounded by μ times both normals, is the same friction
-            // without a redundant row (which made the pivoting degenerate: the arch's 92
-            // rows had rank 63).
+            // without a redundant row (redundant rows make the pivoting degenerate).
             let (kind, point, bound) = if shares_face {
                 let (second, d) = contacts[k + 1];
                 let bound = FrictionBound::shared(first_normal, first_normal + 1, c.friction);

@@ -107,9 +107,9 @@ impl World {
     /// Each solver's pass holds the other's bodies still. Islands are joined by the broad
     /// phase's candidate pairs of this step, not only by last step's contacts, so bodies
     /// that can touch during the step are in one pass: a box falling onto a pile joins
-    /// the pile's pass before it lands. (Joined by last step's contacts only, the landing
-    /// step acted one way, and the smash scene lost 0.7% of its momentum.) Contacts and
-    /// island reports of both passes are kept.
+    /// the pile's pass before it lands: solved in two passes, each would meet the other as
+    /// a fixed body, and the landing would not conserve momentum. Contacts and island
+    /// reports of both passes are kept.
     pub(super) fn step_auto(&mut self, dt: f64) {
         let (exact, soft) = self.mark_soft_islands(dt);
         if !soft {

@@ -76,8 +76,8 @@ impl World {
                 &mut self.manifolds,
             );
             // A pair that may move past the reuse tolerance in this step will not be reused
-            // at the next one: the smash's debris found ~50,000 manifolds a step and reused
-            // ~1,300.
+            // at the next one: flying debris would fill the cache with manifolds that are
+            // never read.
             let (motion_a, motion_b) = (
                 self.bounds.motion[i as usize],
                 self.bounds.motion[j as usize],

@@ -180,8 +180,8 @@ pub struct World {
     /// Bodies with at least one joint, sorted.
     jointed: Vec<u32>,
     /// The joints or ignored pairs changed since `non_colliding` and `jointed` were built:
-    /// they are rebuilt once at the next step, not at every change (a scene of 20,000 pins
-    /// took 12 s to build with a sort per `add_joint`).
+    /// they are rebuilt once at the next step, not at every change (a sort per
+    /// `add_joint` makes building a scene of many pins quadratic).
     collision_filter_stale: bool,
     /// Pairs kept apart by [`World::ignore_collisions`], besides the jointed ones.
     ignored_pairs: Vec<(u32, u32)>,

@@ -18,14 +18,9 @@ use crate::solver::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, REGULA
 /// load down through light bodies slowly: a body rolling at 4 m/s over one 13 times
 /// lighter on the floor went 1.4 smallest radii into it. The coupled solve does both at
 /// once. Each pass after the step's first starts from the last pass's sets: where they
-/// still hold, it solves one triangular system instead of pivoting. Measured with
-/// `physics/examples/throw_survey.rs` (1,600 random throws, then at the length scale of
-/// the smallest radius; the share with a contact deeper than a fifth of that radius after
-/// 2 s): point by point 12.9%; normals in an LCP from 10-fold masses 9.9%, in a quarter
-/// more time; from 4-fold or 2-fold 10.7%, in half as much again; islands of up to 32
-/// points 10.6%, in twice the time. With friction in every small island's LCP too,
-/// 1,000 steps of the random piles of the hard-case tests (17–21 polygons) took 0.14–6.3 s
-/// instead of 0.03–0.05 s.
+/// still hold, it solves one triangular system instead of pivoting. The limits trade
+/// the random throws' deep contacts against their time (docs/bench/profile.md, "The
+/// small islands' LCP: its limits").
 pub(super) const LCP_POINT_LIMIT: usize = 16;
 const LCP_MASS_RATIO: f64 = 100.0;
 const LCP_NORMALS_MASS_RATIO: f64 = 10.0;

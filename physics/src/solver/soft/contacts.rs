@@ -185,8 +185,8 @@ pub(super) fn point_target(
 /// The least normal velocity a point may keep in a biased pass: a soft spring lets a part
 /// of the approach through (1 − its mass scale), and where that would carry the point
 /// deeper than `max_depth` within the substep, it is held there rigidly. Ordinary scenes
-/// never come near it; a box on the floor at a gravity of 1e5 and h = 1 (a hundred
-/// thousand times its size each step) fell through in the first step without it.
+/// never come near it; under gravity that carries a body many times its size in a step,
+/// the spring alone would let it through the floor in the first step.
 #[inline(always)]
 pub(super) fn sinking_floor(separation: f64, pass: &PassSettings) -> f64 {
     lesser(-(pass.max_depth + separation) * pass.inv_h, 0.0)
@@ -280,7 +280,7 @@ pub(super) fn solve_pair(
 /// sets: totals x ≥ 0 with w = (v_n − target) + K (x − x₀) ≥ 0 and x·w = 0, x₀ the
 /// accumulated impulses. Rigid rows (the relax pass, restitution, two speculative points)
 /// are solved so, exactly: one point after the other, the second's push undoes part of
-/// the first's, and two boxes meeting face to face at 12 m/s sank 1.7 mm into each other.
+/// the first's, and two boxes meeting face to face fast sink into each other.
 ///
 /// Soft rows are not: there each point is a spring scaled by its own effective mass, as
 /// in Box2D v3. A face's two springs solved together are coupled through the

@@ -167,9 +167,9 @@ impl Softness {
 /// Laid out for the batches' SIMD paths (`avx2::Avx2Lanes::gather`, `avx512`), which read
 /// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
 /// transpose them into lanes: the two rows start at 0 and 32 bytes. A body is 64-byte
-/// aligned, so that both rows lie in one cache line: at 96 bytes a body, every other one
-/// straddled two, and on the Zen 1, where a big pile's bodies do not stay in the level-2
-/// cache, large_pyramid's passes took 8–10% longer (docs/bench/profile.md).
+/// aligned, so that both rows lie in one cache line: at 96 bytes a body every other one
+/// straddles two, which a big pile whose bodies leave the level-2 cache pays for in
+/// every pass (docs/bench/profile.md, "The Zen 1: the big scenes wait on memory").
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C, align(64))]
 struct SoftBody {
@@ -475,11 +475,9 @@ pub(crate) struct SoftStepSolver {
 /// Gauss–Seidel leaves the constraints it solved last best satisfied: swept always
 /// first to last, the colours favour some constraints over others at every step. Two
 /// substeps forwards, then two backwards, cancel that to first order (symmetric
-/// Gauss–Seidel). With the colours given in the points' order, it took the 100-row
-/// pyramid's largest top sway from 0.23 of a box to 0.022; flipping every substep helped
-/// less (0.086), flipping only the relax pass less still (0.15). With the colours
-/// scattered (`batch::PassPlan::colour_in_scattered_order`) the sway is 0.0065 swept one
-/// way and 0.0025 alternating (Box2D v3: 0.0094): see docs/bench/profile.md.
+/// Gauss–Seidel), better than flipping every substep or only the relax pass; with the
+/// colours scattered (`batch::PassPlan::colour_in_scattered_order`) a tall pyramid's top
+/// sways less than Box2D v3's (docs/bench/profile.md, "Sweeping the colours both ways").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum SweepOrder {
     Forwards,

@@ -4,10 +4,10 @@
 //! goes in batches of eight. Every lane runs `solve_joint`'s arithmetic in its order, so a
 //! batch gives the same bits as its pins solved one after another, on any lane path.
 //!
-//! Solved one after another in the island's order, each pin waited for the one before: a
-//! net's neighbouring pins share a body, so each pin's update could start only once the
-//! last one's velocities were stored. In batches the 100 × 100 net's passes take half the
-//! time (docs/bench/profile.md, "Pins in batches").
+//! Solved one after another in the island's order, each pin would wait for the one
+//! before: a net's neighbouring pins share a body, so each update could start only once
+//! the last one's velocities are stored. In batches they do not wait
+//! (docs/bench/profile.md, "Pins in batches").
 
 use super::batch::{BatchLanes, LaneBatch, LanePath, LaneVelocity, PAD};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};

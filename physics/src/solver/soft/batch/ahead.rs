@@ -9,13 +9,11 @@ use super::{LanePoints, ManifoldBatch, PassItem, PassPlan};
 pub(super) const PREFETCH_AHEAD: usize = 16;
 
 /// From how many bytes of batches the passes ask for each next batch while solving one
-/// (`PassPlan::batches_ahead`). Many megabytes of them come from farther out in every
-/// pass, and the first reads of each batch waited: asked for ahead, the smash's passes
-/// (6.5 MB of batches at step 120) took 30% less time on the Zen 1, large_pyramid's and
-/// many_pyramids' (4.9–5.0 MB) 15–25%. Batches that stay in the caches gain nothing and
-/// pay for the asking: pyramid20's (207 KB) passes 3% slower, pyramid40's (806 KB, past
-/// the level-2 cache but well inside the level-3) warm start 9–12% slower and its solve
-/// 1–2%. The warm start asks for what it reads too.
+/// (`PassPlan::batches_ahead`). Megabytes of batches come from beyond the caches in every
+/// pass, and the first reads of each batch wait unless it was asked for ahead; batches
+/// that stay in the caches gain nothing and pay for the asking, so smaller steps do not
+/// ask (docs/bench/profile.md, "Asking ahead from 2 MB of batches"). The warm start asks
+/// for what it reads too.
 const ASK_AHEAD_FROM_BYTES: usize = 2 * 1024 * 1024;
 
 /// Where the step's batches lie (`PassPlan::batches_ahead`), kept apart from their
@@ -131,9 +129,8 @@ impl<const N: usize> ManifoldBatch<N> {
     }
 
     /// Asks the cache for what the warm start reads of the batch at `batch` (18 of the 31
-    /// lines a pass reads of a two-point batch), as `prefetch`. Asked for whole, the warm
-    /// start took no less time; asked for these, large_pyramid's took 5–15% less on the
-    /// Zen 1 and the smash's 10–30%.
+    /// lines a pass reads of a two-point batch), as `prefetch`: asking for the whole batch
+    /// saves the warm start nothing, asking for these saves it the waits.
     #[inline(always)]
     fn prefetch_for_warm_start(batch: *const Self) {
         use std::mem::{offset_of, size_of};

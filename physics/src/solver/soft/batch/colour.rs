@@ -6,10 +6,9 @@ use crate::solver::island::counting_sort;
 
 /// Colours of the constraint graph, as many as a body's `u32` of colour bits holds (a
 /// manifold that finds no free colour is solved before the colours, one at a time).
-/// Box2D v3 has 24; with 24 the smash's fast debris, whose speculative contacts reach
-/// many neighbours, left about 6,000 of its 59,000 coloured manifolds without a colour,
-/// and 32 took its steps 20–26 from 262.2M to 256.4M instructions a step. Piles need
-/// fewer than 20 and give the same bits either way.
+/// More than Box2D v3's 24: fast debris, whose speculative contacts reach many
+/// neighbours, needs more than 24 to leave few manifolds uncoloured; piles need fewer
+/// than 20 and give the same bits either way.
 pub(super) const COLOURS: u32 = 32;
 
 /// Colours 0–27 are open to manifolds between two moving bodies; those against a fixed
@@ -20,10 +19,9 @@ const DYNAMIC_COLOURS: u32 = COLOURS - 4;
 /// Islands of fewer contact points than this are solved in the points' order, one
 /// manifold at a time: below it, the lanes would stay nearly empty. Unless the small
 /// islands together have this many points, since the colours are shared by every island
-/// and many small ones fill the lanes together (the smash's debris). Coloured, a lone
-/// stack of 2 boxes (4 points) costs the same a step, of 5 boxes 4% less, of 10 boxes
-/// 39% less; three stacks of 2 boxes 30% less (docs/bench/profile.md, "Small islands
-/// coloured"; this was 48, from instructions counted rather than time).
+/// and many small ones fill the lanes together (the smash's debris). From 8 points on,
+/// colouring costs no more than the points' order and soon much less, in time
+/// (docs/bench/profile.md, "Small islands coloured").
 pub(super) const MIN_COLOURED_ISLAND: usize = 8;
 
 /// A manifold of a coloured island, as `plan` sorts them.

@@ -4,18 +4,18 @@
 //! Manifolds of a big island are grouped by colours of the constraint graph (no two in a
 //! colour share a moving body), as Box2D v3 assigns them: manifolds between two moving
 //! bodies from the first colour up, those against a fixed body from the last colour down,
-//! so that contacts with the ground have the last word in every pass. (Against a fixed
-//! body first, the 100-row pyramid fell: 2,068 of 5,050 boxes.) Within a colour, eight
+//! so that contacts with the ground have the last word in every pass: a pile's weight
+//! reaches the ground in the pass it is pushed down, and tall piles stand. Within a
+//! colour, eight
 //! coupled two-point manifolds at a time are one `ManifoldBatch<2>`, and eight one-point
 //! ones a `ManifoldBatch<1>`, solved with the same arithmetic as `solve_pair` and
 //! `solve_point`, lane by lane, so a batch gives the same bits as its eight manifolds
 //! solved one after another, whichever lanes the processor has. Small islands keep the
 //! points' order, one manifold at a time.
 //!
-//! The colours are given in a scattered order (`PassPlan::colour_in_scattered_order`):
-//! given in the points' order, they repeated one pattern across a pile and it swayed. With
-//! that and the sweeps alternating (`SweepOrder`), the 100-row pyramid's top stays within
-//! 0.25% of a box over 500 steps (Box2D v3 0.94%): see docs/bench/profile.md.
+//! The colours are given in a scattered order (`PassPlan::colour_in_scattered_order`), so
+//! that no one pattern repeats across a pile and sways it; with the sweeps alternating
+//! (`SweepOrder`) a tall pyramid's top stays put (docs/bench/profile.md).
 //!
 //! This module holds the plan (`PassPlan`) and the batches' layout (`ManifoldBatch`); the
 //! colouring, the chunks, the batches asked for ahead, the batch pools, the filling, the
