@@ -1,14 +1,11 @@
-//! Pin (revolute) joints by impulses with position prediction (SPEC §2.5, §3.3).
+//! Pin (revolute) joints (SPEC §2.5, §3.3): the joint and its motor, and a joint as the
+//! solvers take it: its anchors, its predicted gap, the impulses that close it one joint
+//! at a time, and its blocks of K = J M⁻¹ Jᵀ. The passes over all of them are
+//! `joint_block`'s.
 
-use super::island::IslandGrouping;
-use super::pin_island::{PinIsland, displace_island};
-use super::{BodiesAndMoving, SolverBody};
+use super::SolverBody;
 use crate::body::BodyHandle;
-use crate::math::{Rot, Vec2, clamp};
-
-/// Islands with at most this many joints are solved by one direct (Cholesky) solve per
-/// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (SPEC §3.3).
-pub(crate) const DIRECT_JOINT_LIMIT: usize = 256;
+use crate::math::{Rot, Vec2};
 
 /// A joint's handle in its world. Handles are never reused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -132,7 +129,7 @@ fn effective_mass_matrix(a: &SolverBody, r_a: Vec2, b: &SolverBody, r_b: Vec2) -
 }
 
 /// Solves `K ψ = rhs` in closed form; `None` if K is singular (both bodies static).
-fn solve_2x2(k: [[f64; 2]; 2], rhs: Vec2) -> Option<Vec2> {
+pub(super) fn solve_2x2(k: [[f64; 2]; 2], rhs: Vec2) -> Option<Vec2> {
     let det = k[0][0] * k[1][1] - k[0][1] * k[1][0];
     if det.abs() <= f64::EPSILON * (k[0][0] * k[1][1]).abs() || det == 0.0 {
         return None;
@@ -156,7 +153,7 @@ impl JointConstraint {
     }
 
     /// Removes the anchors' relative velocity (SPEC eq. 40). Returns |d_v| before.
-    fn correct_velocity(&self, bodies: &mut [SolverBody]) -> f64 {
+    pub(super) fn correct_velocity(&self, bodies: &mut [SolverBody]) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let (r_a, r_b) = self.arms((bodies[ia].angle, bodies[ib].angle));
         let (a, b) = (&bodies[ia], &bodies[ib]);
@@ -181,7 +178,7 @@ impl JointConstraint {
     }
 
     /// One Newton step on the predicted gap (SPEC eq. 34–39). Returns |d| before.
-    fn correct_position(&self, bodies: &mut [SolverBody], dt: f64) -> f64 {
+    pub(super) fn correct_position(&self, bodies: &mut [SolverBody], dt: f64) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let d = self.predicted_gap(bodies, dt) - self.gap_target;
         // The impulse acts at the anchors now, where the pin force really acts (at the
@@ -196,44 +193,6 @@ impl JointConstraint {
         }
         d.norm()
     }
-}
-
-/// Start of step: every joint's anchors stop drifting apart (SPEC §3.3 eq. 40), iterated.
-pub(crate) fn correct_velocities(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    it: &JointIterations,
-) -> usize {
-    for sweep in 0..it.max_sweeps {
-        let mut worst: f64 = 0.0;
-        for j in joints {
-            worst = worst.max(j.correct_velocity(bodies));
-        }
-        if worst < it.velocity_tolerance {
-            return sweep;
-        }
-    }
-    it.max_sweeps
-}
-
-/// After contacts: impulses that make every joint's anchors meet at the end of the step
-/// (SPEC §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
-pub(crate) fn correct_positions(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    dt: f64,
-    it: &JointIterations,
-) -> usize {
-    for sweep in 0..it.max_sweeps {
-        let mut worst: f64 = 0.0;
-        for j in joints.iter() {
-            worst = worst.max(j.correct_position(bodies, dt));
-        }
-        if worst < it.position_tolerance {
-            return sweep;
-        }
-    }
-    it.max_sweeps
 }
 
 /// What a joint's gap should be at the end of this step: closed, or `max_closing` narrower
@@ -256,65 +215,6 @@ pub(crate) fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
     } else {
         Vec2::zeros()
     }
-}
-
-/// Joint motors as bounded velocity constraints, solved by projected Gauss–Seidel on the
-/// accumulated impulse so the bound ±max_torque·h holds over the whole step; unless
-/// `fresh`, keeping the impulses already applied this step so the bound holds over several
-/// rounds.
-fn drive_motors_continue(
-    joints: &mut [JointConstraint],
-    bodies: &mut [SolverBody],
-    dt: f64,
-    sweeps: usize,
-    fresh: bool,
-) {
-    if fresh {
-        for j in joints.iter_mut() {
-            if let Some(m) = j.motor.as_mut() {
-                m.last_impulse = 0.0;
-            }
-        }
-    }
-    for _ in 0..sweeps {
-        for j in joints.iter_mut() {
-            let Some(motor) = j.motor.as_mut().filter(|m| m.enabled) else {
-                continue;
-            };
-            let (ia, ib) = (j.body_a as usize, j.body_b as usize);
-            let k = bodies[ia].inv_inertia + bodies[ib].inv_inertia;
-            if k == 0.0 {
-                continue;
-            }
-            let relative = bodies[ia].angular_velocity - bodies[ib].angular_velocity;
-            let limit = motor.max_torque * dt;
-            let total = clamp(
-                motor.last_impulse - (relative - motor.target_speed) / k,
-                -limit,
-                limit,
-            );
-            let delta = total - motor.last_impulse;
-            motor.last_impulse = total;
-            bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;
-            bodies[ib].angular_velocity -= delta * bodies[ib].inv_inertia;
-        }
-    }
-}
-
-/// Buffers for solving joints island by island, reused across steps.
-#[derive(Debug, Clone, Default)]
-pub(crate) struct JointBlockSolver {
-    islands: JointIslands,
-    pin_island: PinIsland,
-}
-
-/// The joints grouped into islands, one island's copied out at a time.
-#[derive(Debug, Clone, Default)]
-struct JointIslands {
-    /// The joints' islands, kept while the joints and the moving bodies are the same (a
-    /// chain's are found once, not at every pass of every substep).
-    grouping: IslandGrouping,
-    island: Vec<JointConstraint>,
 }
 
 /// The velocity change at joint `p`'s anchors per unit impulse at joint `q`: one 2×2 block
@@ -348,202 +248,10 @@ pub(super) fn coupling_block(
 }
 
 /// `coupling_block` of one joint with itself: its own 2×2 K.
-fn own_block(j: &JointConstraint, bodies: &[SolverBody], ahead: f64) -> [[f64; 2]; 2] {
+pub(super) fn own_block(j: &JointConstraint, bodies: &[SolverBody], ahead: f64) -> [[f64; 2]; 2] {
     let angle = |i: u32| bodies[i as usize].angle;
     let angle_ahead = |i: u32| angle(i) + ahead * bodies[i as usize].angular_velocity;
     let arms_ahead = j.arms((angle_ahead(j.body_a), angle_ahead(j.body_b)));
     let arms_now = j.arms((angle(j.body_a), angle(j.body_b)));
     coupling_block((j, arms_ahead), (j, arms_now), bodies)
-}
-
-/// The repair moves bodies by the smallest mass-weighted displacement, with rotations
-/// made this much costlier than physics would weigh them. A thin link's small inertia
-/// would otherwise let the first-order solve turn links by whole turns to save a little
-/// translation, and the Newton steps stall; translations enter the gaps linearly, so a
-/// chain or tree closes
-/// in one step, and rotation is still used where a closed loop needs it.
-const REPAIR_ROTATION_WEIGHT: f64 = 1e-4;
-
-/// Each joint with its repair target: broken joints `max_closing` narrower (or closed),
-/// the others held as they are.
-fn with_repair_targets(
-    joints: &[JointConstraint],
-    bodies: &[SolverBody],
-    it: &JointIterations,
-) -> Vec<JointConstraint> {
-    joints
-        .iter()
-        .map(|j| {
-            let now = j.predicted_gap(bodies, 0.0);
-            let target = if now.norm() > it.broken_gap {
-                gap_target(now, it.max_closing)
-            } else {
-                now
-            };
-            JointConstraint {
-                gap_target: target,
-                ..*j
-            }
-        })
-        .collect()
-}
-
-fn repair_residual(j: &JointConstraint, bodies: &[SolverBody]) -> Vec2 {
-    j.predicted_gap(bodies, 0.0) - j.gap_target
-}
-
-/// The same repair one joint at a time, by Gauss–Seidel sweeps (large islands).
-fn repair_positions_sequential(
-    joints: &[JointConstraint],
-    bodies: &mut [SolverBody],
-    it: &JointIterations,
-) {
-    let joints = with_repair_targets(joints, bodies, it);
-    for _ in 0..it.max_sweeps {
-        let mut worst: f64 = 0.0;
-        for j in &joints {
-            let d = repair_residual(j, bodies);
-            worst = worst.max(d.norm());
-            let Some(push) = solve_2x2(own_block(j, bodies, 0.0), -d) else {
-                continue;
-            };
-            displace_island(std::slice::from_ref(j), bodies, &[push.x, push.y], 1.0);
-        }
-        if worst < it.position_tolerance {
-            break;
-        }
-    }
-}
-
-/// Body slots an island's joints touch (with repeats).
-fn island_bodies(joints: &[JointConstraint]) -> impl Iterator<Item = usize> + '_ {
-    joints
-        .iter()
-        .flat_map(|j| [j.body_a as usize, j.body_b as usize])
-}
-
-impl JointIslands {
-    /// Calls `solve` once per island with that island's joints, copied contiguously;
-    /// `moving`: the slots of the bodies that move, increasing.
-    fn for_each(
-        &mut self,
-        joints: &mut [JointConstraint],
-        (bodies, moving): BodiesAndMoving<'_>,
-        mut solve: impl FnMut(&mut [JointConstraint], &mut [SolverBody]),
-    ) {
-        let grouped = self.grouping.group(
-            joints.len(),
-            bodies.len(),
-            |i| (joints[i].body_a, joints[i].body_b),
-            moving,
-        );
-        let mut start = 0;
-        while start < grouped.len() {
-            let root = grouped[start].0;
-            let end = start
-                + grouped[start..]
-                    .iter()
-                    .take_while(|(r, _)| *r == root)
-                    .count();
-            self.island.clear();
-            self.island
-                .extend(grouped[start..end].iter().map(|&(_, i)| joints[i as usize]));
-            solve(&mut self.island, bodies);
-            for (k, &(_, i)) in grouped[start..end].iter().enumerate() {
-                joints[i as usize] = self.island[k];
-            }
-            start = end;
-        }
-    }
-}
-
-impl JointBlockSolver {
-    /// Before a step: every broken joint (wider than [`JointIterations::broken_gap`]) is
-    /// pulled up to `max_closing` closer by moving the bodies of its island, which adds no
-    /// kinetic energy — a stretched chain snaps together instead of whipping. Does
-    /// nothing (and costs one pass over the joints) when no joint is broken.
-    pub(crate) fn repair_positions(
-        &mut self,
-        joints: &mut [JointConstraint],
-        (bodies, moving): BodiesAndMoving<'_>,
-        it: &JointIterations,
-    ) {
-        if joints
-            .iter()
-            .all(|j| j.predicted_gap(bodies, 0.0).norm() <= it.broken_gap)
-        {
-            return;
-        }
-        let pin_island = &mut self.pin_island;
-        self.islands
-            .for_each(joints, (bodies, moving), |island, bodies| {
-                let mut slots: Vec<usize> = island_bodies(island).collect();
-                slots.sort_unstable();
-                slots.dedup();
-                for &i in &slots {
-                    bodies[i].inv_inertia *= REPAIR_ROTATION_WEIGHT;
-                }
-                let direct = island.len() <= DIRECT_JOINT_LIMIT;
-                let targets = || with_repair_targets(island, bodies, it);
-                if !(direct && pin_island.repair(&targets(), bodies, it)) {
-                    repair_positions_sequential(island, bodies, it);
-                }
-                for &i in &slots {
-                    bodies[i].inv_inertia /= REPAIR_ROTATION_WEIGHT;
-                }
-            });
-    }
-
-    /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
-    pub(crate) fn correct_velocities(
-        &mut self,
-        joints: &mut [JointConstraint],
-        bodies: BodiesAndMoving<'_>,
-        it: &JointIterations,
-    ) {
-        let pin_island = &mut self.pin_island;
-        self.islands.for_each(joints, bodies, |island, bodies| {
-            let direct = island.len() <= DIRECT_JOINT_LIMIT;
-            let solved = direct && pin_island.stop_drift(island, bodies);
-            if !solved {
-                correct_velocities(island, bodies, it);
-            }
-        });
-    }
-
-    /// Stage 6 (SPEC §3.3): motors, then Newton steps on the predicted gaps until every
-    /// joint closes. Motors and joints alternate so that both hold at the end;
-    /// `motors_started` says the motors' impulses of this step so far are in place.
-    pub(crate) fn correct_positions(
-        &mut self,
-        joints: &mut [JointConstraint],
-        bodies: BodiesAndMoving<'_>,
-        dt: f64,
-        it: &JointIterations,
-        motors_started: bool,
-    ) {
-        let pin_island = &mut self.pin_island;
-        self.islands.for_each(joints, bodies, |island, bodies| {
-            let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
-            let direct = island.len() <= DIRECT_JOINT_LIMIT;
-            if !direct {
-                if has_motor {
-                    drive_motors_continue(island, bodies, dt, 10, !motors_started);
-                }
-                correct_positions(island, bodies, dt, it);
-                return;
-            }
-            let outer = if has_motor { 8 } else { 1 };
-            for round in 0..outer {
-                if has_motor {
-                    // Keep what the contact solve already pushed so the bound holds overall.
-                    drive_motors_continue(island, bodies, dt, 4, round == 0 && !motors_started);
-                }
-                if !pin_island.close_gaps(island, bodies, dt, it) {
-                    correct_positions(island, bodies, dt, it);
-                    break;
-                }
-            }
-        });
-    }
 }

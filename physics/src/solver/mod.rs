@@ -4,6 +4,7 @@ pub(crate) mod contact;
 pub(crate) mod envelope;
 pub(crate) mod island;
 pub(crate) mod joint;
+pub(crate) mod joint_block;
 pub(crate) mod lcp;
 pub(crate) mod motor;
 mod pin_island;

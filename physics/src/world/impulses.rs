@@ -6,7 +6,8 @@
 use super::{Pipeline, World};
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
-use crate::solver::joint::{JointBlockSolver, JointConstraint, JointIterations};
+use crate::solver::joint::{JointConstraint, JointIterations};
+use crate::solver::joint_block::JointBlockSolver;
 use crate::solver::simultaneous::FrictionModel;
 use crate::solver::system::VelocityTargets;
 use crate::solver::{BodiesAndMoving, ImpulseMethod};
