@@ -182,6 +182,19 @@ impl IslandGrouping {
     }
 }
 
+/// The index range of each island in `grouped` (`group_by_island`'s result, sorted by
+/// island).
+pub(crate) fn island_ranges(grouped: &[(u32, u32)], ranges: &mut Vec<(usize, usize)>) {
+    ranges.clear();
+    let mut start = 0;
+    while start < grouped.len() {
+        let root = grouped[start].0;
+        let len = grouped[start..].iter().take_while(|g| g.0 == root).count();
+        ranges.push((start, start + len));
+        start += len;
+    }
+}
+
 /// The slots of two increasing lists, increasing, each once.
 pub(crate) fn merged_increasing<'a>(a: &'a [u32], b: &'a [u32]) -> impl Iterator<Item = u32> + 'a {
     let (mut a, mut b) = (a.iter().copied().peekable(), b.iter().copied().peekable());

@@ -4,12 +4,11 @@
 
 use super::batch::PlanInput;
 use super::contact_lcp::LCP_POINT_LIMIT;
-use super::prepare::island_ranges;
 use super::{NormalBlock, PointConstraint, PointLevers, SoftStepSolver, row_coupling};
 use crate::math::Vec2;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
-use crate::solver::island::IslandGrouping;
+use crate::solver::island::{IslandGrouping, island_ranges};
 
 /// The contacts' islands as `build_points` takes them: `(island, contact)` pairs
 /// (`IslandGrouping::grouped`), and, where they were taken unchecked, the bodies of the

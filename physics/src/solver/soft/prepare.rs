@@ -7,7 +7,7 @@ use super::{SoftBody, SoftJoint, SoftStepSolver};
 use crate::math::{Rot, Vec2};
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
-use crate::solver::island::{IslandGrouping, merged_increasing};
+use crate::solver::island::{IslandGrouping, island_ranges, merged_increasing};
 use crate::solver::joint::JointConstraint;
 use crate::stage_clock::{self, Stage};
 
@@ -295,17 +295,5 @@ impl SoftStepSolver {
             std::mem::swap(&mut self.joints, &mut self.spare_joints);
         }
         island_ranges(grouped, &mut self.joint_islands);
-    }
-}
-
-/// The index range of each island in `grouped` (sorted by island).
-pub(super) fn island_ranges(grouped: &[(u32, u32)], ranges: &mut Vec<(usize, usize)>) {
-    ranges.clear();
-    let mut start = 0;
-    while start < grouped.len() {
-        let root = grouped[start].0;
-        let len = grouped[start..].iter().take_while(|g| g.0 == root).count();
-        ranges.push((start, start + len));
-        start += len;
     }
 }

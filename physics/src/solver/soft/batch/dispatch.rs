@@ -6,9 +6,7 @@ use super::super::SoftBody;
 use super::super::avx2::{BothHalves, LowerHalf};
 #[cfg(target_arch = "x86_64")]
 use super::super::avx512::F64x8Avx512;
-use super::super::lanes::{F64x8, LANES, Lanes};
-use super::solve::PassSettings;
-use super::{ManifoldBatch, PAD};
+use super::super::lanes::{F64x8, Lanes};
 
 /// The lanes a batch is solved with: the widest this processor has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -193,16 +191,4 @@ fn warm_start_avx512<B: LaneBatch>(batch: &B, bodies: &mut [SoftBody]) {
 fn solve_avx512<B: LaneBatch>(batch: &mut B, bodies: &mut [SoftBody], pass: &B::Pass) {
     // SAFETY: this function runs only where the processor has AVX-512F.
     unsafe { as_lanes_mut::<B, F64x8Avx512>(batch) }.solve_lanes(bodies, pass)
-}
-
-// SAFETY: `ManifoldBatch<N, L>` is `repr(C)` with lanes of `F64x8`'s size and alignment
-// (asserted with the struct), any bits valid in each.
-unsafe impl<const N: usize> LaneBatch for ManifoldBatch<N> {
-    type Pass = PassSettings;
-    type With<L: Lanes> = ManifoldBatch<N, L>;
-
-    #[inline(always)]
-    fn upper_half_used(&self) -> bool {
-        self.first_point[LANES / 2..].iter().any(|&f| f != PAD)
-    }
 }

@@ -3,8 +3,8 @@
 
 use super::super::lanes::{LANES, LaneMask, Lanes};
 use super::super::{BodyRow, SoftBody, Softness};
-use super::dispatch::BatchLanes;
-use super::{LaneBounce, LanePoints, ManifoldBatch};
+use super::dispatch::{BatchLanes, LaneBatch};
+use super::{LaneBounce, LanePoints, ManifoldBatch, PAD};
 
 /// A body's velocity, lane by lane.
 #[derive(Debug, Clone, Copy)]
@@ -299,6 +299,18 @@ impl<const N: usize, L: Lanes> ManifoldBatch<N, L> {
         for (((p, impulse), bounce), total) in points.zip(&mut self.bounce).zip([total1, total2]) {
             apply_normal(pair, (p, impulse), BOUNCE.then_some(bounce), normal, total);
         }
+    }
+}
+
+// SAFETY: `ManifoldBatch<N, L>` is `repr(C)` with lanes of `F64x8`'s size and alignment
+// (asserted with the struct), any bits valid in each.
+unsafe impl<const N: usize> LaneBatch for ManifoldBatch<N> {
+    type Pass = PassSettings;
+    type With<L: Lanes> = ManifoldBatch<N, L>;
+
+    #[inline(always)]
+    fn upper_half_used(&self) -> bool {
+        self.first_point[LANES / 2..].iter().any(|&f| f != PAD)
     }
 }
 
