@@ -14,6 +14,7 @@
 
 mod box2d_scenes;
 mod cradle;
+mod format;
 mod harness;
 mod machine;
 mod pe_scenes;

@@ -1,8 +1,8 @@
 //! The big scenes (piles, the joint grid, the smash): pe soft and the peers alone, taking
 //! turns round after round; and pe soft with the narrow phase's manifold reuse on and off.
 
+use crate::format::{pretty, ratio_range, time_ratio};
 use crate::harness::interleaved;
-use crate::report::{pretty, time_ratio};
 use crate::scene::{H, PYRAMIDS, joint_grid, smash};
 use crate::{Job, Outcome, box2d_scenes, pe_scenes, rapier_scenes};
 use pe::ContactSolver;
@@ -61,14 +61,6 @@ impl PileRound {
         let of = |peer: &Outcome| time_ratio(self.pe.timing.median, peer.timing.median);
         (of(&self.rapier), of(&self.box2d))
     }
-}
-
-/// The smallest and largest of some ratios, as "lo–hi".
-pub fn ratio_range(ratios: impl Iterator<Item = f64>) -> String {
-    let (lo, hi) = ratios.fold((f64::INFINITY, 0.0_f64), |(lo, hi), r| {
-        (lo.min(r), hi.max(r))
-    });
-    format!("{lo:.2}–{hi:.2}")
 }
 
 /// `pile <scene> [rounds]`: pe soft, rapier2d and Box2D v3 on one pile (or the joint grid,

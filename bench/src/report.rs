@@ -1,26 +1,12 @@
 //! results.md: the tables of the main run, from the rows the runs return.
 
+use crate::format::{pretty, ratio_range, time_ratio};
 use crate::harness::{RUN_BUDGET, TURN_STEPS, Timing, WARMUP_STEPS, WARMUP_WALL};
 use crate::machine::{PeerBuild, locked_version, machine, rapier_version, today};
-use crate::piles::{NarrowRow, PILE_ROUNDS, PileRound, ratio_range};
+use crate::piles::{NarrowRow, PILE_ROUNDS, PileRound};
 use crate::{Outcome, PE_SOLVERS, PEERS, Row, box2d_scenes, robots, throws};
 use std::fmt::Write as _;
 use std::time::Duration;
-
-/// A duration with three significant figures in a readable unit.
-pub fn pretty(d: Duration) -> String {
-    let s = d.as_secs_f64();
-    let (value, unit) = match s {
-        s if s < 1e-3 => (s * 1e6, "µs"),
-        s if s < 1.0 => (s * 1e3, "ms"),
-        s => (s, "s"),
-    };
-    match value {
-        v if v < 10.0 => format!("{v:.2} {unit}"),
-        v if v < 100.0 => format!("{v:.1} {unit}"),
-        v => format!("{v:.0} {unit}"),
-    }
-}
 
 /// A time cell: the median, flagged when the run was cut short by the budget.
 pub fn time_cell(t: &Timing) -> String {
@@ -41,11 +27,6 @@ pub fn metric_cell(o: &Outcome) -> String {
     } else {
         o.metric.to_string()
     }
-}
-
-/// pe's time over a peer's.
-pub fn time_ratio(pe: Duration, peer: Duration) -> f64 {
-    pe.as_secs_f64() / peer.as_secs_f64()
 }
 
 pub fn ratio(pe: Duration, peer: Duration) -> String {

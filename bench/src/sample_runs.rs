@@ -392,7 +392,7 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
         );
         for r in pivoting {
             let (e, s) = (&r.pe[exact].timing, &r.pe[soft].timing);
-            let over = crate::report::time_ratio(e.median, s.median);
+            let over = crate::format::time_ratio(e.median, s.median);
             let _ = writeln!(
                 w,
                 "| {} | {} of {} | {} | {} | {over:.2} | {} |",
@@ -425,7 +425,7 @@ pub fn write(w: &mut String, rows: &[SampleRow]) {
             SMALL_BUDGET.as_secs_f64() * 1e3,
             PE_SOLVERS[0].name(),
             slowest.name,
-            crate::report::pretty(slowest.pe[0].timing.median)
+            crate::format::pretty(slowest.pe[0].timing.median)
         );
     }
 }

@@ -230,7 +230,7 @@ pub fn run(out_dir: &str) -> String {
                     md,
                     " {:.2e} in {}{cut} |",
                     p.error,
-                    crate::report::pretty(p.timing.median)
+                    crate::format::pretty(p.timing.median)
                 );
             }
             let _ = writeln!(md);
