@@ -1,10 +1,136 @@
 //! The soft step's pins and motors: each pin's last impulses kept for warm starting, a
 //! small island of pins solved as one linear system, and a pin or motor solved alone.
 
+use super::bodies::LoadedBodies;
 use super::contacts::BodyPair;
+use super::pins::PinPlan;
 use super::{SoftBody, SoftJoint, SoftStepSolver, Softness};
 use crate::math::{Rot, Vec2, clamp, cross_scalar};
+use crate::solver::SolverBody;
 use crate::solver::envelope::EnvelopeCholesky;
+use crate::solver::island::{IslandGrouping, island_ranges};
+use crate::solver::joint::JointConstraint;
+
+/// The soft step's pins and motors for a step: each pin as the passes read it, grouped by
+/// island, with its remembered impulses, and the plans of the small islands' block solve
+/// and the big islands' batches.
+#[derive(Debug, Clone, Default)]
+pub(super) struct SoftPins {
+    pub(super) joints: Vec<SoftJoint>,
+    pub(super) spare_joints: Vec<SoftJoint>,
+    pub(super) joint_memory: JointMemory,
+    /// The pinned bodies' rotations at the step's start, found as the pins need them.
+    pub(super) rotations: Vec<Option<Rot>>,
+    /// `joints` indices of the pins with a motor, in `joints`' order.
+    pub(super) motor_joints: Vec<u32>,
+    /// `joints` index ranges, one per island of pins, and the buffers of their solve.
+    pub(super) joint_islands: Vec<(usize, usize)>,
+    /// The big pin islands' batches (`pins`).
+    pub(super) pin_plan: PinPlan,
+    /// The pins' islands, kept while the pins join the same bodies.
+    pub(super) joint_grouping: IslandGrouping,
+    pub(super) block: JointBlock,
+}
+
+impl SoftPins {
+    /// The pins that can act this step, their last impulses recalled, grouped by island,
+    /// and the big islands' batches planned.
+    pub(super) fn prepare(
+        &mut self,
+        bodies: &[SolverBody],
+        joints: &[JointConstraint],
+        loaded: &LoadedBodies,
+    ) {
+        // Each pinned body's rotation once: a body of a net carries four pins.
+        self.rotations.clear();
+        if !joints.is_empty() {
+            self.rotations.resize(bodies.len(), None);
+        }
+        self.joints.clear();
+        self.joint_memory.begin(joints.len());
+        let mut cursor = 0;
+        for (input, j) in joints.iter().enumerate() {
+            let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
+            // A pin between two fixed bodies (asleep, or held for the other solver's pass
+            // under `auto`) can do nothing: it is left out, so neither its island nor its
+            // motor's reading (the other pass's) is touched.
+            let fixed = |b: &SolverBody| b.inv_mass == 0.0 && b.inv_inertia == 0.0;
+            let remembered = self.joint_memory.recall(j.joint, &mut cursor);
+            if fixed(a) && fixed(b) {
+                // Kept, so that the pin warm-starts again when its bodies move.
+                if let Some(entry) = remembered {
+                    self.joint_memory.keep(input as u32, entry);
+                }
+                continue;
+            }
+            let mut turned = |i: u32| {
+                *self.rotations[i as usize]
+                    .get_or_insert_with(|| Rot::new(bodies[i as usize].angle))
+            };
+            let (r_a, r_b) = j.arms_turned((turned(j.body_a), turned(j.body_b)));
+            let (_, impulse, motor_impulse) = remembered.unwrap_or(JointMemory::NONE);
+            let motor = j
+                .motor
+                .filter(|m| m.enabled)
+                .map(|m| (m.target_speed, m.max_torque));
+            self.joints.push(SoftJoint {
+                a: j.body_a,
+                b: j.body_b,
+                r_a,
+                r_b,
+                // The soft step always pulls towards a closed pin (a broken joint too),
+                // no faster than `max_push_speed`; the target the other solvers use to
+                // repair broken joints over several steps does not apply here.
+                base_gap: (a.position + r_a) - (b.position + r_b),
+                impulse,
+                // Warm starting applies the remembered motor impulse in every substep: a
+                // motor switched off or removed must not keep driving its joint with it.
+                motor_impulse: if motor.is_some() { motor_impulse } else { 0.0 },
+                motor_step_total: 0.0,
+                motor,
+                slot: j.joint,
+                input: input as u32,
+            });
+        }
+        self.group(loaded);
+        self.block.begin_step(self.joint_islands.len());
+        self.motor_joints.clear();
+        let motors = self
+            .joints
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.motor.is_some());
+        self.motor_joints.extend(motors.map(|(k, _)| k as u32));
+        let unchanged = self.joint_grouping.kept();
+        self.pin_plan
+            .plan(&self.joints, &self.joint_islands, &loaded.bodies, unchanged);
+    }
+
+    /// Orders `joints` island by island (pins linked through moving bodies; each island
+    /// keeps the joints' order) and records each island's range.
+    fn group(&mut self, loaded: &LoadedBodies) {
+        let joints = &self.joints;
+        let grouped = self.joint_grouping.group(
+            joints.len(),
+            loaded.bodies.len(),
+            |i| (joints[i].a, joints[i].b),
+            &loaded.moving,
+        );
+        // A net's pins are one island, in the joints' own order: nothing to move, and
+        // copying every joint is skipped.
+        if grouped
+            .iter()
+            .enumerate()
+            .any(|(k, &(_, i))| i as usize != k)
+        {
+            self.spare_joints.clear();
+            self.spare_joints
+                .extend(grouped.iter().map(|&(_, i)| joints[i as usize]));
+            std::mem::swap(&mut self.joints, &mut self.spare_joints);
+        }
+        island_ranges(grouped, &mut self.joint_islands);
+    }
+}
 
 /// Last step's pin impulses (linear, and the motor's angular one) by joint slot.
 #[derive(Debug, Clone, Default)]
@@ -377,7 +503,7 @@ mod tests {
         let steps = |gravity: Vec2, count: usize, every_pass: bool| {
             let (mut bodies, mut joints) = rods(6);
             let mut solver = SoftStepSolver::default();
-            solver.block.factor_every_pass = every_pass;
+            solver.pins.block.factor_every_pass = every_pass;
             let gravity = vec![(gravity, 0.0); bodies.len()];
             let mut bits = Vec::new();
             for k in 0..count {

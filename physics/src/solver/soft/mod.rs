@@ -19,7 +19,7 @@ use crate::math::{Rot, Vec2};
 use crate::stage_clock::{self, Stage, StepProfile};
 use crate::world::stats::StepStats;
 use batch::{LanePath, PassPlan, PassSettings, PlanInput};
-use pins::PinPlan;
+use bodies::LoadedBodies;
 
 /// `$entry`, running `$inline` compiled with FMA where the processor has it (the copy
 /// `$fma`, with the feature enabled) and as built otherwise: `f64::mul_add` is then one
@@ -55,6 +55,7 @@ mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod avx512;
 mod batch;
+mod bodies;
 mod contact_lcp;
 mod contacts;
 mod joints;
@@ -67,7 +68,7 @@ mod restitution;
 mod store;
 
 use contact_lcp::ContactLcp;
-use joints::{JointBlock, JointMemory};
+use joints::SoftPins;
 use passes::{integrate_position, integrate_velocity};
 
 /// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
@@ -395,10 +396,11 @@ struct SoftJoint {
 /// Warm-start memory and buffers, kept between steps.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SoftStepSolver {
-    bodies: Vec<SoftBody>,
+    /// The bodies as the step reads them, and which of them move.
+    loaded: LoadedBodies,
+    /// The pins and their motors as the step solves them.
+    pins: SoftPins,
     points: Vec<PointConstraint>,
-    joints: Vec<SoftJoint>,
-    spare_joints: Vec<SoftJoint>,
     /// Last step's contact impulses, recalled as this step's points are built.
     memory: ContactMemory,
     /// Each contact's impulses from the last step (`ContactMemory::recall`).
@@ -406,43 +408,10 @@ pub(crate) struct SoftStepSolver {
     /// Each contact's impulses from this step, gathered from the lanes and the points
     /// before they go into the contacts in one sweep (`store`).
     impulses: Vec<(f64, f64)>,
-    joint_memory: JointMemory,
-    /// The pinned bodies' rotations at the step's start, found as the pins need them.
-    rotations: Vec<Option<Rot>>,
-    /// `joints` indices of the pins with a motor, in `joints`' order.
-    motor_joints: Vec<u32>,
-    /// By body, whether a pin joins it (empty if there are no pins): such a body's
-    /// island is solved with the rest, not in a chunk (`PassPlan::assign_chunks`).
-    pinned: Vec<bool>,
-    /// Whether a fixed body has a velocity this step (a static body the caller set moving):
-    /// its motion counts in every substep of the islands it touches, which a chunk solved
-    /// apart would not see, so the chunks are then solved with the rest.
-    a_fixed_body_moves: bool,
-    /// The bodies that move or have a velocity, increasing: the only ones the substeps
-    /// integrate (a terrain of 2,000 static tiles is not walked four times a step).
-    in_motion: Vec<u32>,
-    /// The bodies that move, increasing: the ones `store` writes back.
-    moving: Vec<u32>,
-    /// The fixed bodies with a velocity (a conveyor), increasing: loaded again every
-    /// step, as their motion within a step is the solver's own.
-    fixed_in_motion: Vec<u32>,
-    /// The slots, increasing, whose bodies alone may differ from those the last step was
-    /// handed (`bodies_changed_only`), for the next step; unless set, every body.
-    changed_only: Vec<u32>,
-    only_those_changed: bool,
-    /// Scratch for `load_bodies`: last step's fixed bodies in motion.
-    spare_slots: Vec<u32>,
     /// `points` index ranges, one per island of contacts.
     contact_islands: Vec<(usize, usize)>,
-    /// `joints` index ranges, one per island of pins, and the buffers of their solve.
-    joint_islands: Vec<(usize, usize)>,
-    /// The big pin islands' batches (`pins`).
-    pin_plan: PinPlan,
     /// The contacts' islands, kept while the contacts stay between the same bodies.
     contact_grouping: IslandGrouping,
-    /// The pins' islands, kept while the pins join the same bodies.
-    joint_grouping: IslandGrouping,
-    block: JointBlock,
     contact_lcp: ContactLcp,
     /// The passes' order over the manifolds outside the LCP islands, and what it is made
     /// from: each manifold's entry, noted as its points are built.
@@ -524,14 +493,12 @@ impl SoftStepSolver {
     /// moves is among them; the rest are fixed, and at rest or as they were. The step
     /// then loads only those, and the fixed bodies with a velocity.
     pub(crate) fn bodies_changed_only(&mut self, slots: &[u32]) {
-        self.changed_only.clear();
-        self.changed_only.extend_from_slice(slots);
-        self.only_those_changed = true;
+        self.loaded.changed_only(slots);
     }
 
     /// How many times the pin islands' matrices were factored (`StepStats`).
     pub(crate) fn pin_factorisations(&self) -> u64 {
-        self.block.factored
+        self.pins.block.factored
     }
 
     /// Advances `bodies` by `dt`: velocities from `accelerations` (linear, angular per
@@ -577,7 +544,7 @@ impl SoftStepSolver {
                 let order = sweep_order(self.substeps_taken.wrapping_add(substep as u64));
                 for &i in self.plan.chunk(k).1 {
                     let i = i as usize;
-                    integrate_velocity(&mut self.bodies[i], accelerations[i], h);
+                    integrate_velocity(&mut self.loaded.bodies[i], accelerations[i], h);
                 }
                 let started = stage_clock::mark();
                 // The first substep's passes read the chunk's batches from farther out and
@@ -589,7 +556,7 @@ impl SoftStepSolver {
                 let started = stage_clock::mark();
                 self.sweep_items(items.clone(), &pass(true), order, ask);
                 for &i in self.plan.chunk(k).1 {
-                    integrate_position(&mut self.bodies[i as usize], h);
+                    integrate_position(&mut self.loaded.bodies[i as usize], h);
                 }
                 self.sweep_items(items.clone(), &pass(false), order, false);
                 self.profile.record(Stage::Solve, started);
@@ -609,8 +576,8 @@ impl SoftStepSolver {
             self.profile.record(Stage::Solve, started);
             // Warm starting re-applies the accumulated impulse in every substep, so the
             // step's total is the sum of the substeps' accumulated values.
-            for &k in &self.motor_joints {
-                let j = &mut self.joints[k as usize];
+            for &k in &self.pins.motor_joints {
+                let j = &mut self.pins.joints[k as usize];
                 j.motor_step_total += j.motor_impulse;
             }
         }
@@ -619,7 +586,7 @@ impl SoftStepSolver {
             self.plan.scatter(&mut self.points);
             self.restitution(bounce_below);
         }
-        self.pin_plan.scatter(&mut self.joints);
+        self.pins.pin_plan.scatter(&mut self.pins.joints);
         let started = stage_clock::mark();
         self.store(bodies, contacts, joints);
         self.profile.record(Stage::Storing, started);
@@ -808,7 +775,7 @@ mod tests {
                 state_bits(&bodies_some, &contacts_some),
                 "step {k}"
             );
-            assert_eq!(some.a_fixed_body_moves, k >= 8, "step {k}");
+            assert_eq!(some.loaded.a_fixed_body_moves, k >= 8, "step {k}");
         }
         assert_eq!(steps_loading_some, 14);
     }

@@ -41,7 +41,7 @@ impl SoftStepSolver {
     /// None if a fixed body moves: then the rest's passes take the chunks' items too, in
     /// their order, which solves every island as the chunks would.
     pub(super) fn chunks_apart(&self) -> usize {
-        if self.a_fixed_body_moves {
+        if self.loaded.a_fixed_body_moves {
             0
         } else {
             self.plan.chunk_count()
@@ -60,8 +60,8 @@ impl SoftStepSolver {
     /// The rest's bodies' velocities (those no chunk moves).
     pub(super) fn integrate_velocities(&mut self, accelerations: &[(Vec2, f64)], h: f64) {
         let chunked = self.chunks_apart() > 0;
-        for &i in &self.in_motion {
-            let (i, b) = (i as usize, &mut self.bodies[i as usize]);
+        for &i in &self.loaded.in_motion {
+            let (i, b) = (i as usize, &mut self.loaded.bodies[i as usize]);
             if b.moves() && !(chunked && self.plan.in_chunk(i)) {
                 integrate_velocity(b, accelerations[i], h);
             }
@@ -72,10 +72,10 @@ impl SoftStepSolver {
     /// would stay where it is to the last bit: only `in_motion` is walked.
     pub(super) fn integrate_positions(&mut self, h: f64) {
         let chunked = self.chunks_apart() > 0;
-        for &i in &self.in_motion {
+        for &i in &self.loaded.in_motion {
             let i = i as usize;
             if !(chunked && self.plan.in_chunk(i)) {
-                integrate_position(&mut self.bodies[i], h);
+                integrate_position(&mut self.loaded.bodies[i], h);
             }
         }
     }
@@ -83,31 +83,34 @@ impl SoftStepSolver {
     pub(super) fn warm_start(&mut self) {
         for &(start, end, ..) in &self.contact_lcp.islands {
             for p in &self.points[start..end] {
-                warm_start_point(&mut self.bodies, p);
+                warm_start_point(&mut self.loaded.bodies, p);
             }
         }
         self.warm_start_items(self.rest_items(), true);
         // Each pin's impulse and its motor's, pin by pin; the batched islands' pins, then
         // their motors'.
-        for &(start, end) in &self.joint_islands {
+        for &(start, end) in &self.pins.joint_islands {
             if !PinPlan::batches_island(end - start) {
-                for j in &self.joints[start..end] {
-                    warm_start_pin(&mut self.bodies, j);
-                    warm_start_motor(&mut self.bodies, j);
+                for j in &self.pins.joints[start..end] {
+                    warm_start_pin(&mut self.loaded.bodies, j);
+                    warm_start_motor(&mut self.loaded.bodies, j);
                 }
             }
         }
-        self.pin_plan.warm_start(&mut self.bodies);
-        for &k in self.pin_plan.alone() {
-            warm_start_pin(&mut self.bodies, &self.joints[k as usize]);
+        self.pins.pin_plan.warm_start(&mut self.loaded.bodies);
+        for &k in self.pins.pin_plan.alone() {
+            warm_start_pin(&mut self.loaded.bodies, &self.pins.joints[k as usize]);
         }
-        for &(start, end) in &self.joint_islands {
+        for &(start, end) in &self.pins.joint_islands {
             if PinPlan::batches_island(end - start) {
                 // `motor_joints` is in the joints' order.
-                let from = self.motor_joints.partition_point(|&k| (k as usize) < start);
-                let motors = self.motor_joints[from..].iter();
+                let from = self
+                    .pins
+                    .motor_joints
+                    .partition_point(|&k| (k as usize) < start);
+                let motors = self.pins.motor_joints[from..].iter();
                 for &k in motors.take_while(|&&k| (k as usize) < end) {
-                    warm_start_motor(&mut self.bodies, &self.joints[k as usize]);
+                    warm_start_motor(&mut self.loaded.bodies, &self.pins.joints[k as usize]);
                 }
             }
         }
@@ -129,14 +132,16 @@ impl SoftStepSolver {
         let ahead = self.plan.batches_ahead().only_if(ask);
         for item in ahead.asking(self.plan.items[items].iter(), AskedFor::WarmStart) {
             match *item {
-                PassItem::Batch(k) => batches[k as usize].warm_start_on(lanes, &mut self.bodies),
+                PassItem::Batch(k) => {
+                    batches[k as usize].warm_start_on(lanes, &mut self.loaded.bodies)
+                }
                 PassItem::PointBatch(k) => {
-                    point_batches[k as usize].warm_start_on(lanes, &mut self.bodies)
+                    point_batches[k as usize].warm_start_on(lanes, &mut self.loaded.bodies)
                 }
                 PassItem::Manifold(first, count) => {
                     let (first, count) = (first as usize, count as usize);
                     for p in &self.points[first..first + count] {
-                        warm_start_point(&mut self.bodies, p);
+                        warm_start_point(&mut self.loaded.bodies, p);
                     }
                 }
             }
@@ -170,7 +175,7 @@ impl SoftStepSolver {
         let work = (
             batches,
             point_batches,
-            &mut self.bodies[..],
+            &mut self.loaded.bodies[..],
             &mut self.points[..],
         );
         match order {
@@ -193,18 +198,22 @@ impl SoftStepSolver {
         order: SweepOrder,
     ) {
         let joint_push = settings.joint_push_speed;
-        for &k in &self.motor_joints {
-            solve_motor(&mut self.bodies, &mut self.joints[k as usize], h);
+        for &k in &self.pins.motor_joints {
+            solve_motor(
+                &mut self.loaded.bodies,
+                &mut self.pins.joints[k as usize],
+                h,
+            );
         }
-        for (index, &(start, end)) in self.joint_islands.iter().enumerate() {
-            let island = &mut self.joints[start..end];
+        for (index, &(start, end)) in self.pins.joint_islands.iter().enumerate() {
+            let island = &mut self.pins.joints[start..end];
             if PinPlan::batches_island(island.len()) {
                 continue;
             }
             // A lone pin's 2 × 2 is solved in closed form below.
             let solved = island.len() >= 2
-                && self.block.solve(
-                    &mut self.bodies,
+                && self.pins.block.solve(
+                    &mut self.loaded.bodies,
                     (index, island),
                     joint_soft,
                     joint_push,
@@ -212,7 +221,7 @@ impl SoftStepSolver {
                 );
             if !solved {
                 for j in island.iter_mut() {
-                    solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
+                    solve_joint(&mut self.loaded.bodies, j, joint_soft, joint_push, use_bias);
                 }
             }
         }
@@ -221,14 +230,14 @@ impl SoftStepSolver {
             max_push: joint_push,
             use_bias,
         };
-        self.pin_plan.solve(&mut self.bodies, &pin_pass);
-        for &k in self.pin_plan.alone() {
-            let j = &mut self.joints[k as usize];
-            solve_joint(&mut self.bodies, j, joint_soft, joint_push, use_bias);
+        self.pins.pin_plan.solve(&mut self.loaded.bodies, &pin_pass);
+        for &k in self.pins.pin_plan.alone() {
+            let j = &mut self.pins.joints[k as usize];
+            solve_joint(&mut self.loaded.bodies, j, joint_soft, joint_push, use_bias);
         }
         let pass = contact_pass(h, contact_soft, settings, use_bias);
         self.contact_lcp
-            .solve(&mut self.bodies, &mut self.points, &pass);
+            .solve(&mut self.loaded.bodies, &mut self.points, &pass);
         // In the plan's order: small islands in the points' order, then big ones colour
         // by colour (or their colours backwards), eight manifolds at a time (see `batch`).
         let (rest, coloured_from) = (self.rest_items(), self.plan.coloured_from);

@@ -68,7 +68,7 @@ impl SoftStepSolver {
             if c.restitution != 0.0 {
                 return false;
             }
-            let moves = |i: u32| self.bodies[i as usize].moves();
+            let moves = |i: u32| self.loaded.bodies[i as usize].moves();
             let mut input = PlanInput::new(
                 (c.body_a.0, c.body_b.0),
                 k,
@@ -81,8 +81,8 @@ impl SoftStepSolver {
             }
             let coupled = second.is_some_and(|j| {
                 let pair = (
-                    &self.bodies[c.body_a.index()],
-                    &self.bodies[c.body_b.index()],
+                    &self.loaded.bodies[c.body_a.index()],
+                    &self.loaded.bodies[c.body_b.index()],
                 );
                 let (p, q) = (
                     PointLevers::of(bodies, c),
@@ -103,13 +103,14 @@ impl SoftStepSolver {
             (c.body_a.0, c.body_b.0)
         };
         self.contact_lcp
-            .classify(&self.bodies, &self.contact_islands, ends);
+            .classify(&self.loaded.bodies, &self.contact_islands, ends);
         self.plan.read(
             &self.contact_lcp.all_islands,
             &self.planned_inputs,
-            &self.pinned,
+            &self.loaded.pinned,
         );
-        self.plan.plan_before_points(contacts.len(), &self.bodies);
+        self.plan
+            .plan_before_points(contacts.len(), &self.loaded.bodies);
         true
     }
 
@@ -117,9 +118,9 @@ impl SoftStepSolver {
     pub(super) fn group_contacts(&mut self, grouping: &mut IslandGrouping, contacts: &[Contact]) {
         let grouped = grouping.group(
             contacts.len(),
-            self.bodies.len() - 1, // not the null body
+            self.loaded.bodies.len() - 1, // not the null body
             |i| (contacts[i].body_a.0, contacts[i].body_b.0),
-            &self.moving,
+            &self.loaded.moving,
         );
         island_ranges(grouped, &mut self.contact_islands);
     }
@@ -203,12 +204,12 @@ impl SoftStepSolver {
                 .map(|j| self.build_point(bodies, accelerations, contacts, j, dt, &mut reading));
             let block = second.as_ref().and_then(|q| {
                 let pair = (
-                    &self.bodies[c.body_a.index()],
-                    &self.bodies[c.body_b.index()],
+                    &self.loaded.bodies[c.body_a.index()],
+                    &self.loaded.bodies[c.body_b.index()],
                 );
                 NormalBlock::of(pair, (&first, q))
             });
-            let moves = |i: u32| self.bodies[i as usize].moves();
+            let moves = |i: u32| self.loaded.bodies[i as usize].moves();
             let mut input = PlanInput::new(
                 (c.body_a.0, c.body_b.0),
                 k,
@@ -313,7 +314,9 @@ impl SoftStepSolver {
         manifold: [PointConstraint; N],
         small: bool,
     ) -> bool {
-        let in_lane = self.plan.fill_manifold(first, &manifold, &self.bodies);
+        let in_lane = self
+            .plan
+            .fill_manifold(first, &manifold, &self.loaded.bodies);
         #[cfg(test)]
         let small = small || self.write_every_point;
         if in_lane && !small {

@@ -1,13 +1,12 @@
 //! The step's preparation: the bodies loaded, the contacts grouped by island, their
 //! points built and the passes planned, and the pins loaded and grouped.
 
-use super::joints::JointMemory;
+use super::SoftStepSolver;
 use super::points::ContactsRegrouped;
-use super::{SoftBody, SoftJoint, SoftStepSolver};
-use crate::math::{Rot, Vec2};
+use crate::math::Vec2;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
-use crate::solver::island::{IslandGrouping, island_ranges, merged_increasing};
+use crate::solver::island::IslandGrouping;
 use crate::solver::joint::JointConstraint;
 use crate::stage_clock::{self, Stage};
 
@@ -23,72 +22,11 @@ impl SoftStepSolver {
         dt: f64,
     ) {
         let started = stage_clock::mark();
-        self.load_bodies(bodies, joints);
+        self.loaded.load(bodies, joints);
         let (grouping, reused) = self.take_contact_grouping(contacts, bodies.len());
         self.profile.record(Stage::PreparingIslands, started);
         self.prepare_points(bodies, accelerations, contacts, dt, (grouping, reused));
-        self.prepare_pins(bodies, joints);
-    }
-
-    /// The bodies as the soft step reads them, the null body last, and which bodies a pin
-    /// joins: every body, or where the caller said which changed (`bodies_changed_only`)
-    /// those and the fixed bodies with a velocity.
-    fn load_bodies(&mut self, bodies: &[SolverBody], joints: &[JointConstraint]) {
-        let only_some =
-            std::mem::take(&mut self.only_those_changed) && self.bodies.len() == bodies.len() + 1;
-        self.in_motion.clear();
-        self.moving.clear();
-        let mut fixed_in_motion = std::mem::take(&mut self.fixed_in_motion);
-        if only_some {
-            let changed = std::mem::take(&mut self.changed_only);
-            let mut was_in_motion = std::mem::take(&mut self.spare_slots);
-            was_in_motion.clone_from(&fixed_in_motion);
-            fixed_in_motion.clear();
-            for i in merged_increasing(&changed, &was_in_motion) {
-                self.bodies[i as usize] = SoftBody::at_step_start(&bodies[i as usize]);
-                self.note_motion(i, &mut fixed_in_motion);
-            }
-            self.changed_only = changed;
-            self.spare_slots = was_in_motion;
-            // The null body, last: where a batch's unused lanes point (`batch::PAD`).
-            *self.bodies.last_mut().expect("the null body") = SoftBody::null();
-        } else {
-            fixed_in_motion.clear();
-            self.bodies.clear();
-            self.bodies
-                .extend(bodies.iter().map(SoftBody::at_step_start));
-            for i in 0..bodies.len() as u32 {
-                self.note_motion(i, &mut fixed_in_motion);
-            }
-            // The null body, last: where a batch's unused lanes point (`batch::PAD`). Fixed
-            // and at rest, and past the bodies `store` writes back.
-            self.bodies.push(SoftBody::null());
-        }
-        self.a_fixed_body_moves = !fixed_in_motion.is_empty();
-        self.fixed_in_motion = fixed_in_motion;
-        self.pinned.clear();
-        if !joints.is_empty() {
-            self.pinned.resize(bodies.len(), false);
-            for j in joints {
-                self.pinned[j.body_a as usize] = true;
-                self.pinned[j.body_b as usize] = true;
-            }
-        }
-    }
-
-    /// Lists body `i`, just loaded, among those that move, those in motion and the fixed
-    /// ones in motion, as it is.
-    fn note_motion(&mut self, i: u32, fixed_in_motion: &mut Vec<u32>) {
-        let body = &self.bodies[i as usize];
-        let has_velocity = body.v != Vec2::zeros() || body.w != 0.0;
-        if body.moves() {
-            self.moving.push(i);
-        } else if has_velocity {
-            fixed_in_motion.push(i);
-        }
-        if body.moves() || has_velocity {
-            self.in_motion.push(i);
-        }
+        self.pins.prepare(bodies, joints, &self.loaded);
     }
 
     /// The contacts' islands: last step's grouping, taken unchecked where
@@ -105,7 +43,7 @@ impl SoftStepSolver {
         // its last grouping is taken unchecked, and the points, which read every contact,
         // check each one's bodies against it as they are built.
         let mut grouping = std::mem::take(&mut self.contact_grouping);
-        let reused = grouping.bodies_kept(contacts.len(), body_count, &self.moving);
+        let reused = grouping.bodies_kept(contacts.len(), body_count, &self.loaded.moving);
         if !reused {
             self.group_contacts(&mut grouping, contacts);
         }
@@ -167,7 +105,7 @@ impl SoftStepSolver {
         self.profile.record(Stage::PreparingPoints, started);
         let started = stage_clock::mark();
         self.contact_lcp
-            .prepare(&self.bodies, &self.points, &self.contact_islands);
+            .prepare(&self.loaded.bodies, &self.points, &self.contact_islands);
         // The plan was made from the manifolds the points make (the same pairing, from
         // the same levers), and nothing bounces: it stands, its lanes filled.
         debug_assert!(
@@ -177,7 +115,7 @@ impl SoftStepSolver {
             || self.plan.read(
                 &self.contact_lcp.all_islands,
                 &self.plan_inputs,
-                &self.pinned,
+                &self.loaded.pinned,
             );
         self.profile.record(Stage::PreparingPlan, started);
         let rebuild = skipped && (!kept || self.may_bounce);
@@ -199,101 +137,8 @@ impl SoftStepSolver {
         self.contact_grouping = grouping;
         if !planned_first {
             let started = stage_clock::mark();
-            self.plan.plan(&self.points, &self.bodies);
+            self.plan.plan(&self.points, &self.loaded.bodies);
             self.profile.record(Stage::PreparingPlan, started);
         }
-    }
-
-    /// The pins that can act this step, their last impulses recalled, grouped by island,
-    /// and the big islands' batches planned.
-    fn prepare_pins(&mut self, bodies: &[SolverBody], joints: &[JointConstraint]) {
-        // Each pinned body's rotation once: a body of a net carries four pins.
-        self.rotations.clear();
-        if !joints.is_empty() {
-            self.rotations.resize(bodies.len(), None);
-        }
-        self.joints.clear();
-        self.joint_memory.begin(joints.len());
-        let mut cursor = 0;
-        for (input, j) in joints.iter().enumerate() {
-            let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
-            // A pin between two fixed bodies (asleep, or held for the other solver's pass
-            // under `auto`) can do nothing: it is left out, so neither its island nor its
-            // motor's reading (the other pass's) is touched.
-            let fixed = |b: &SolverBody| b.inv_mass == 0.0 && b.inv_inertia == 0.0;
-            let remembered = self.joint_memory.recall(j.joint, &mut cursor);
-            if fixed(a) && fixed(b) {
-                // Kept, so that the pin warm-starts again when its bodies move.
-                if let Some(entry) = remembered {
-                    self.joint_memory.keep(input as u32, entry);
-                }
-                continue;
-            }
-            let mut turned = |i: u32| {
-                *self.rotations[i as usize]
-                    .get_or_insert_with(|| Rot::new(bodies[i as usize].angle))
-            };
-            let (r_a, r_b) = j.arms_turned((turned(j.body_a), turned(j.body_b)));
-            let (_, impulse, motor_impulse) = remembered.unwrap_or(JointMemory::NONE);
-            let motor = j
-                .motor
-                .filter(|m| m.enabled)
-                .map(|m| (m.target_speed, m.max_torque));
-            self.joints.push(SoftJoint {
-                a: j.body_a,
-                b: j.body_b,
-                r_a,
-                r_b,
-                // The soft step always pulls towards a closed pin (a broken joint too),
-                // no faster than `max_push_speed`; the target the other solvers use to
-                // repair broken joints over several steps does not apply here.
-                base_gap: (a.position + r_a) - (b.position + r_b),
-                impulse,
-                // Warm starting applies the remembered motor impulse in every substep: a
-                // motor switched off or removed must not keep driving its joint with it.
-                motor_impulse: if motor.is_some() { motor_impulse } else { 0.0 },
-                motor_step_total: 0.0,
-                motor,
-                slot: j.joint,
-                input: input as u32,
-            });
-        }
-        self.group_joints();
-        self.block.begin_step(self.joint_islands.len());
-        self.motor_joints.clear();
-        let motors = self
-            .joints
-            .iter()
-            .enumerate()
-            .filter(|(_, j)| j.motor.is_some());
-        self.motor_joints.extend(motors.map(|(k, _)| k as u32));
-        let unchanged = self.joint_grouping.kept();
-        self.pin_plan
-            .plan(&self.joints, &self.joint_islands, &self.bodies, unchanged);
-    }
-
-    /// Orders `joints` island by island (pins linked through moving bodies; each island
-    /// keeps the joints' order) and records each island's range.
-    fn group_joints(&mut self) {
-        let joints = &self.joints;
-        let grouped = self.joint_grouping.group(
-            joints.len(),
-            self.bodies.len(),
-            |i| (joints[i].a, joints[i].b),
-            &self.moving,
-        );
-        // A net's pins are one island, in the joints' own order: nothing to move, and
-        // copying every joint is skipped.
-        if grouped
-            .iter()
-            .enumerate()
-            .any(|(k, &(_, i))| i as usize != k)
-        {
-            self.spare_joints.clear();
-            self.spare_joints
-                .extend(grouped.iter().map(|&(_, i)| joints[i as usize]));
-            std::mem::swap(&mut self.joints, &mut self.spare_joints);
-        }
-        island_ranges(grouped, &mut self.joint_islands);
     }
 }

@@ -24,21 +24,21 @@ impl SoftStepSolver {
                 let (p, q) = (&mut first[i], &mut second[0]);
                 let target = |p: &PointConstraint| -p.restitution * p.relative_velocity;
                 let targets = (target(p), target(q));
-                let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
+                let mut pair = BodyPair::load(&self.loaded.bodies, p.a, p.b);
                 let velocities = (pair.normal_velocity(p), pair.normal_velocity(q));
                 solve_normal_pair(&mut pair, (p, q), velocities, targets);
-                pair.store(&mut self.bodies);
+                pair.store(&mut self.loaded.bodies);
                 i += 2;
                 continue;
             }
             let stride = if paired { 2 } else { 1 };
             for p in &mut self.points[i..i + stride] {
                 if bounces(p) {
-                    let mut pair = BodyPair::load(&self.bodies, p.a, p.b);
+                    let mut pair = BodyPair::load(&self.loaded.bodies, p.a, p.b);
                     let vn = pair.normal_velocity(p);
                     let impulse = -p.normal_mass * (vn + p.restitution * p.relative_velocity);
                     apply_normal(&mut pair, p, p.normal_impulse + impulse);
-                    pair.store(&mut self.bodies);
+                    pair.store(&mut self.loaded.bodies);
                 }
             }
             i += stride;

@@ -12,7 +12,7 @@ impl SoftStepSolver {
     /// Records how each island of contacts and of pins was solved.
     pub(super) fn report(&mut self) {
         self.reports.clear();
-        for &(start, end) in &self.joint_islands {
+        for &(start, end) in &self.pins.joint_islands {
             let pins = end - start;
             self.reports.push(IslandReport {
                 contacts: 0,
@@ -51,8 +51,8 @@ impl SoftStepSolver {
         contacts: &mut [Contact],
         joints: &mut [JointConstraint],
     ) {
-        for &i in &self.moving {
-            let (b, s) = (&mut bodies[i as usize], &self.bodies[i as usize]);
+        for &i in &self.loaded.moving {
+            let (b, s) = (&mut bodies[i as usize], &self.loaded.bodies[i as usize]);
             b.velocity = s.v;
             b.angular_velocity = s.w;
             b.position += s.dp;
@@ -91,14 +91,15 @@ impl SoftStepSolver {
         }
         self.memory.store_from(contacts, &impulses);
         self.impulses = impulses;
-        for j in &self.joints {
-            self.joint_memory
+        for j in &self.pins.joints {
+            self.pins
+                .joint_memory
                 .keep(j.input, (j.slot, j.impulse, j.motor_impulse));
             if let Some(m) = joints[j.input as usize].motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
                 m.step_impulse = j.motor_step_total;
             }
         }
-        self.joint_memory.finish();
+        self.pins.joint_memory.finish();
     }
 }
