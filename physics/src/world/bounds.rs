@@ -65,12 +65,12 @@ impl BodyBounds {
         &mut self,
         i: usize,
         body: Option<&Body>,
-        (velocity, spin): (Vec2, f64),
+        (velocity, angular_velocity): (Vec2, f64),
         dt: f64,
         margin: f64,
     ) {
         // The speed of its farthest point from the spin alone.
-        let spin = body.map_or(0.0, |b| spin.abs() * b.bounding_radius());
+        let spin = body.map_or(0.0, |b| angular_velocity.abs() * b.bounding_radius());
         let reach = (velocity.norm() + spin) * dt;
         self.reach[i] = reach;
         self.motion[i] = (velocity * dt, spin * dt);
