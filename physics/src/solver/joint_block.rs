@@ -4,7 +4,7 @@
 //! (SPEC §3.3); motors driven as bounded velocity constraints; broken joints repaired by
 //! positions.
 
-use super::island::IslandGrouping;
+use super::island::{IslandGrouping, island_ranges};
 use super::joint::{JointConstraint, JointIterations, gap_target, own_block, solve_2x2};
 use super::pin_island::{PinIsland, displace_island};
 use super::{BodiesAndMoving, SolverBody};
@@ -108,6 +108,8 @@ struct JointIslands {
     /// The joints' islands, kept while the joints and the moving bodies are the same (a
     /// chain's are found once, not at every pass of every substep).
     grouping: IslandGrouping,
+    /// Each island's range in the grouping.
+    ranges: Vec<(usize, usize)>,
     island: Vec<JointConstraint>,
 }
 
@@ -192,14 +194,8 @@ impl JointIslands {
             |i| (joints[i].body_a, joints[i].body_b),
             moving,
         );
-        let mut start = 0;
-        while start < grouped.len() {
-            let root = grouped[start].0;
-            let end = start
-                + grouped[start..]
-                    .iter()
-                    .take_while(|(r, _)| *r == root)
-                    .count();
+        island_ranges(grouped, &mut self.ranges);
+        for &(start, end) in &self.ranges {
             self.island.clear();
             self.island
                 .extend(grouped[start..end].iter().map(|&(_, i)| joints[i as usize]));
@@ -207,7 +203,6 @@ impl JointIslands {
             for (k, &(_, i)) in grouped[start..end].iter().enumerate() {
                 joints[i as usize] = self.island[k];
             }
-            start = end;
         }
     }
 }

@@ -3,7 +3,7 @@
 //! one boxed LCP whose friction bounds follow the normal impulses.
 
 use super::contact::{Contact, ContactMemory};
-use super::island::IslandGrouping;
+use super::island::{IslandGrouping, island_ranges};
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
@@ -384,18 +384,7 @@ impl SimultaneousSolver {
             .grouping
             .group(nc + joint_count, bodies.len(), ends, moving);
         self.contact_count = nc;
-        self.ranges.clear();
-        let mut start = 0;
-        while start < grouped.len() {
-            let root = grouped[start].0;
-            let end = start
-                + grouped[start..]
-                    .iter()
-                    .take_while(|(r, _)| *r == root)
-                    .count();
-            self.ranges.push((start, end));
-            start = end;
-        }
+        island_ranges(grouped, &mut self.ranges);
     }
 
     /// Copies island `island`'s contacts and joints into the island buffers.

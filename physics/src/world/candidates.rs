@@ -193,7 +193,7 @@ impl World {
     /// move in `dt`, overlap (pairs of fixed bodies and pairs kept apart left out).
     pub(super) fn find_candidate_pairs(&mut self, dt: f64) {
         self.sets.refresh(&self.bodies);
-        let s = &mut self.scratch;
+        let (candidates, s) = (&mut self.scratch.pairs, &mut self.scratch.candidates);
         let kept = &mut self.kept_pairs;
         let n = self.bodies.len();
         let margin = self.settings.contact_margin();
@@ -248,9 +248,7 @@ impl World {
             fixed_slots.clear();
             fixed_slots.extend(merged_increasing(self.sets.statics(), self.sets.sleeping()));
             if fixed_slots.len() < FIXED_CELLS_FROM {
-                s.candidates
-                    .broad_phase
-                    .pairs(&kept.bounds, wanted, &mut kept.pairs);
+                s.broad_phase.pairs(&kept.bounds, wanted, &mut kept.pairs);
             } else {
                 let listed_with = (made_for, grow.to_bits());
                 if kept.fixed_cells_for != Some(listed_with) {
@@ -258,21 +256,20 @@ impl World {
                     kept.fixed_cells_for = Some(listed_with);
                 }
                 let moving = self.sets.awake();
-                s.candidates
-                    .broad_phase
+                s.broad_phase
                     .pairs_among(&kept.bounds, moving, wanted, &mut kept.pairs);
                 kept.fixed_cells
                     .pairs_with(&kept.bounds, moving, wanted, &mut kept.pairs);
-                s.candidates.broad_phase.sort_pairs(&mut kept.pairs, n);
+                s.broad_phase.sort_pairs(&mut kept.pairs, n);
             }
-            s.candidates.radii.clear();
-            s.candidates.radii.extend(
+            s.radii.clear();
+            s.radii.extend(
                 bodies
                     .iter()
                     .map(|b| b.as_ref().map_or(0.0, Body::bounding_radius)),
             );
-            let room_taken = &mut s.candidates.neighbours.room_taken;
-            kept.crowded = crowded(&kept.pairs, fixed, &s.candidates.radii, room_taken);
+            let room_taken = &mut s.neighbours.room_taken;
+            kept.crowded = crowded(&kept.pairs, fixed, &s.radii, room_taken);
         }
         // The candidates: the pairs whose bounds overlap now, in the broad phase's order.
         let boxes = &bounds.boxes;
@@ -280,37 +277,27 @@ impl World {
             (Some(a), Some(b)) => a.overlaps(b),
             _ => false,
         };
-        s.pairs.clear();
+        candidates.clear();
         if self.sets.in_pass() {
             // `auto`'s pass: a pair is wanted where one of its bodies moves in the pass.
             let (fixed, sets) = (&kept.fixed, &self.sets);
             let fixed_in_pass = |i: u32| fixed[i as usize] || sets.is_held(i);
             let one_moves = |&(i, j): &(u32, u32)| !(fixed_in_pass(i) && fixed_in_pass(j));
-            s.pairs.extend(
+            candidates.extend(
                 kept.pairs
                     .iter()
                     .copied()
                     .filter(|p| one_moves(p) && overlap(p)),
             );
         } else {
-            s.pairs.extend(kept.pairs.iter().copied().filter(overlap));
+            candidates.extend(kept.pairs.iter().copied().filter(overlap));
         }
         if kept.crowded {
-            s.candidates.grown_by.clear();
-            s.candidates
-                .grown_by
+            s.grown_by.clear();
+            s.grown_by
                 .extend(bounds.reach.iter().map(|reach| 0.5 * margin + reach));
-            let sizes = (
-                &bounds.boxes[..],
-                &s.candidates.grown_by[..],
-                &s.candidates.radii[..],
-            );
-            keep_nearest_neighbours(
-                &mut s.pairs,
-                &kept.fixed,
-                sizes,
-                &mut s.candidates.neighbours,
-            );
+            let sizes = (&bounds.boxes[..], &s.grown_by[..], &s.radii[..]);
+            keep_nearest_neighbours(candidates, &kept.fixed, sizes, &mut s.neighbours);
         }
     }
 }
