@@ -3,34 +3,21 @@
 //! `cargo run --release -p pe --example chain_profile -- exact 600 [links]`.
 //! Prints the time per step, the widest any pin opened, and a hash of the final state
 //! (to check that a change leaves the trajectory bit for bit).
-use pe::{BodyDef, ConvexPolygon, JointDef, Vec2, World};
 use std::time::Instant;
 
 #[path = "support/profile_args.rs"]
 mod profile_args;
+#[path = "support/state_hash.rs"]
+mod state_hash;
+#[path = "support/worlds.rs"]
+mod worlds;
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let solver = profile_args::solver(&mut args, "exact");
     let steps = profile_args::count(&mut args, 600);
     let links = profile_args::count(&mut args, 10);
-    let mut w = World::new(Vec2::new(0.0, 10.0));
-    w.settings.contact_solver = solver;
-    let link = ConvexPolygon::rectangle(1.0, 0.1).unwrap();
-    let end = ConvexPolygon::rectangle(1.0, 1.0).unwrap();
-    let mut previous = None;
-    let mut pins = Vec::new();
-    for i in 0..=links {
-        let def = if i < links {
-            BodyDef::new(link.clone(), 2.0).at(Vec2::new(i as f64 + 0.5, 0.0), 0.0)
-        } else {
-            BodyDef::new(end.clone(), 100.0).at(Vec2::new(links as f64 + 0.5, 0.0), 0.0)
-        };
-        let body = w.add_body(def).unwrap();
-        let pin = JointDef::new(body, previous, Vec2::new(i as f64, 0.0));
-        pins.push(w.add_joint(pin).unwrap());
-        previous = Some(body);
-    }
+    let (mut w, pins) = worlds::heavy_chain(solver, links);
     let started = Instant::now();
     let mut widest: f64 = 0.0;
     for _ in 0..steps {
@@ -40,7 +27,7 @@ fn main() {
         }
     }
     let per_step = started.elapsed().as_secs_f64() / steps as f64;
-    let hash = profile_args::state_hash(&w);
+    let hash = state_hash::state_hash(&w);
     println!(
         "{solver:?}: {links} links, {:.1} µs/step (mean of {steps}); widest pin gap {widest:.2e}; state {hash:016x}",
         per_step * 1e6

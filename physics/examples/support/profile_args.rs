@@ -1,5 +1,5 @@
-//! What the profiling examples share: their arguments and a hash of the final state.
-use pe::{ContactSolver, World};
+//! The profiling examples' arguments.
+use pe::ContactSolver;
 
 /// The next argument as a contact solver (`default` if there is none); an unknown name
 /// ends the program with the list of known ones.
@@ -15,17 +15,4 @@ pub fn solver(args: &mut impl Iterator<Item = String>, default: &str) -> Contact
 /// The next argument as a count (`default` if there is none or it is not a number).
 pub fn count(args: &mut impl Iterator<Item = String>, default: usize) -> usize {
     args.next().and_then(|s| s.parse().ok()).unwrap_or(default)
-}
-
-/// Every body's state folded bit for bit: two runs print the same hash only if they
-/// ended in the same state.
-#[allow(dead_code)] // not every example prints it
-pub fn state_hash(world: &World) -> u64 {
-    let mut hash: u64 = 0;
-    for (_, b) in world.bodies() {
-        for v in b.state() {
-            hash = hash.rotate_left(5) ^ v.to_bits();
-        }
-    }
-    hash
 }
