@@ -18,7 +18,12 @@ pub use pe::limits;
 
 /// "`what` {value} is larger than {limit}" when `value` exceeds `limit` in magnitude.
 pub fn beyond(what: &str, value: f64, limit: f64) -> Option<String> {
-    (value.abs() > limit).then(|| format!("{what} {value:e} is beyond ±{limit:e}"))
+    let limit_text = if limit == std::f64::consts::PI {
+        "π (half a turn a step)".to_string()
+    } else {
+        format!("{limit:e}")
+    };
+    (value.abs() > limit).then(|| format!("{what} {value:e} is beyond ±{limit_text}"))
 }
 
 /// The messages of every `(what, value, limit)` whose value is beyond its limit.

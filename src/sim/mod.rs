@@ -374,6 +374,13 @@ impl Simulation {
                 let name = id.map_or(format!("body {body}"), |b| format!("\"{}\"", clip(&b.id)));
                 e.to_string().replacen(&format!("body {body}"), &name, 1)
             }
+            pe::StepError::PinTorn { joint, .. } | pe::StepError::MotorTooFast { joint, .. } => {
+                let id = self.joints.iter().find(|j| j.handle.0 == joint);
+                let name = id.map_or(format!("joint {joint}"), |j| {
+                    format!("joint \"{}\"", clip(&j.id))
+                });
+                e.to_string().replacen(&format!("joint {joint}"), &name, 1)
+            }
             e => e.to_string(),
         })
     }

@@ -45,6 +45,9 @@ pub(crate) struct JointConstraint {
     /// The predicted gap this step's position pass aims for: zero, unless the joint is
     /// broken wider than one step may close (see [`JointIterations::max_closing`]).
     pub gap_target: Vec2,
+    /// The impulse the pin has put on body A (−it on B) since the joint was gathered: the
+    /// world sums it over a step's passes into the pin's reaction.
+    pub impulse: Vec2,
 }
 
 /// Drives the relative angular velocity ω_A − ω_B to `target_speed` with a torque of at
@@ -153,7 +156,7 @@ impl JointConstraint {
     }
 
     /// Removes the anchors' relative velocity (SPEC eq. 40). Returns |d_v| before.
-    pub(super) fn correct_velocity(&self, bodies: &mut [SolverBody]) -> f64 {
+    pub(super) fn correct_velocity(&mut self, bodies: &mut [SolverBody]) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let (r_a, r_b) = self.arms((bodies[ia].angle, bodies[ib].angle));
         let (a, b) = (&bodies[ia], &bodies[ib]);
@@ -163,6 +166,7 @@ impl JointConstraint {
             let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
             bodies[ia].apply_impulse(psi, pa);
             bodies[ib].apply_impulse(-psi, pb);
+            self.impulse += psi;
         }
         d_v.norm()
     }
@@ -178,7 +182,7 @@ impl JointConstraint {
     }
 
     /// One Newton step on the predicted gap (SPEC eq. 34–39). Returns |d| before.
-    pub(super) fn correct_position(&self, bodies: &mut [SolverBody], dt: f64) -> f64 {
+    pub(super) fn correct_position(&mut self, bodies: &mut [SolverBody], dt: f64) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let d = self.predicted_gap(bodies, dt) - self.gap_target;
         // The impulse acts at the anchors now, where the pin force really acts (at the
@@ -190,6 +194,7 @@ impl JointConstraint {
             let (pa, pb) = (bodies[ia].position + r_a, bodies[ib].position + r_b);
             bodies[ia].apply_impulse(psi, pa);
             bodies[ib].apply_impulse(-psi, pb);
+            self.impulse += psi;
         }
         d.norm()
     }

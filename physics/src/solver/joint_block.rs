@@ -6,7 +6,9 @@
 
 use super::island::{IslandGrouping, island_ranges};
 use super::joint::{JointConstraint, JointIterations, gap_target, own_block, solve_2x2};
+use super::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use super::pin_island::{PinIsland, displace_island};
+use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 use super::{BodiesAndMoving, SolverBody};
 use crate::math::{Vec2, clamp};
 
@@ -16,13 +18,13 @@ pub(crate) const DIRECT_JOINT_LIMIT: usize = 256;
 
 /// Start of step: every joint's anchors stop drifting apart (SPEC §3.3 eq. 40), iterated.
 pub(crate) fn correct_velocities(
-    joints: &[JointConstraint],
+    joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
     it: &JointIterations,
 ) -> usize {
     for sweep in 0..it.max_sweeps {
         let mut worst: f64 = 0.0;
-        for j in joints {
+        for j in joints.iter_mut() {
             worst = worst.max(j.correct_velocity(bodies));
         }
         if worst < it.velocity_tolerance {
@@ -35,14 +37,14 @@ pub(crate) fn correct_velocities(
 /// After contacts: impulses that make every joint's anchors meet at the end of the step
 /// (SPEC §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
 pub(crate) fn correct_positions(
-    joints: &[JointConstraint],
+    joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
     dt: f64,
     it: &JointIterations,
 ) -> usize {
     for sweep in 0..it.max_sweeps {
         let mut worst: f64 = 0.0;
-        for j in joints.iter() {
+        for j in joints.iter_mut() {
             worst = worst.max(j.correct_position(bodies, dt));
         }
         if worst < it.position_tolerance {
@@ -100,6 +102,7 @@ fn drive_motors_continue(
 pub(crate) struct JointBlockSolver {
     islands: JointIslands,
     pin_island: PinIsland,
+    motor_speeds: MotorSpeeds,
 }
 
 /// The joints grouped into islands, one island's copied out at a time.
@@ -272,7 +275,7 @@ impl JointBlockSolver {
         it: &JointIterations,
         motors_started: bool,
     ) {
-        let pin_island = &mut self.pin_island;
+        let (pin_island, motor_speeds) = (&mut self.pin_island, &mut self.motor_speeds);
         self.islands.for_each(joints, bodies, |island, bodies| {
             let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
@@ -294,6 +297,88 @@ impl JointBlockSolver {
                     break;
                 }
             }
+            if has_motor {
+                // Holding the speeds moves the anchors' predicted gaps at second order;
+                // one more Newton pass closes them, and holding again undoes what that
+                // did to the speeds, to second order of a second order.
+                motor_speeds.hold(island, bodies, dt);
+                if pin_island.close_gaps(island, bodies, dt, it) {
+                    motor_speeds.hold(island, bodies, dt);
+                }
+            }
         });
+    }
+}
+
+/// The last word on an island's motors: the pins' Newton steps close the gaps by changing
+/// velocities, and in a closed loop (a four-bar's crank) that changes the speed a motor
+/// drove its joint to. One LCP of the motors' rows and the pins' rows
+/// puts each motor at its speed (within what its torque has left this step) while every
+/// pin's anchors keep the relative velocity the Newton steps gave them.
+#[derive(Debug, Clone, Default)]
+struct MotorSpeeds {
+    rows: Vec<Row>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    x: Vec<f64>,
+    lcp: LcpSolver,
+}
+
+impl MotorSpeeds {
+    fn hold(&mut self, island: &mut [JointConstraint], bodies: &mut [SolverBody], dt: f64) {
+        let targets = VelocityTargets {
+            dt,
+            bounce_below: f64::INFINITY,
+            friction: false,
+        };
+        velocity_rows(&[], island, bodies, &targets, &mut self.rows);
+        for row in self.rows.iter_mut() {
+            match row.kind {
+                // As they are: the closing the Newton steps gave them stays.
+                RowKind::JointX(_) | RowKind::JointY(_) => row.b = 0.0,
+                RowKind::JointMotor(k) => {
+                    let applied = island[k as usize].motor.map_or(0.0, |m| m.last_impulse);
+                    (row.lo, row.hi) = (row.lo - applied, row.hi - applied);
+                }
+                _ => {}
+            }
+        }
+        assemble(&self.rows, bodies, &mut self.a);
+        self.b.clear();
+        self.lo.clear();
+        self.hi.clear();
+        for r in &self.rows {
+            self.b.push(r.b);
+            self.lo.push(r.lo.min(0.0));
+            self.hi.push(r.hi.max(0.0));
+        }
+        let problem = LcpProblem {
+            n: self.rows.len(),
+            a: &self.a,
+            b: &self.b,
+            lo: &self.lo,
+            hi: &self.hi,
+            friction_index: None,
+            regularisation: REGULARISATION,
+        };
+        let stats = self.lcp.solve(&problem, &mut self.x);
+        if stats.method == LcpMethod::Rejected || !self.x.iter().all(|x| x.is_finite()) {
+            return;
+        }
+        for (row, &x) in self.rows.iter().zip(&self.x) {
+            row.apply(bodies, x);
+            match row.kind {
+                RowKind::JointX(k) => island[k as usize].impulse.x += x,
+                RowKind::JointY(k) => island[k as usize].impulse.y += x,
+                RowKind::JointMotor(k) => {
+                    if let Some(m) = island[k as usize].motor.as_mut() {
+                        m.last_impulse += x;
+                    }
+                }
+                _ => {}
+            }
+        }
     }
 }

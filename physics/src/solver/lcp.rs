@@ -131,6 +131,8 @@ pub(crate) struct LcpSolver {
     previous: Vec<f64>,
     /// The round before `previous`'s solution (damped friction bounds).
     older: Vec<f64>,
+    /// The regularisation added to each row's diagonal (0 for an equality row).
+    regularised: Vec<f64>,
     /// Whether `set`, `clamped` and `factor` are the last solution's (`solve_again`).
     sets_valid: bool,
 }
@@ -308,12 +310,15 @@ impl LcpSolver {
             last_change = change;
             std::mem::swap(&mut self.older, &mut self.previous);
         }
-        for ((out, scaled), scale) in x.iter_mut().zip(&self.x).zip(&self.scale).take(n) {
-            *out = scaled * scale;
-        }
         // The sets and the factor are a solution's (for `solve_again`) only if no round
         // fell back to Gauss–Seidel.
         self.sets_valid = pivoted && method == LcpMethod::Pivoting;
+        if self.sets_valid {
+            self.refine_clamped();
+        }
+        for ((out, scaled), scale) in x.iter_mut().zip(&self.x).zip(&self.scale).take(n) {
+            *out = scaled * scale;
+        }
         stats.method = method;
         stats.residual = f64::NAN;
         stats
@@ -413,6 +418,62 @@ impl LcpSolver {
         true
     }
 
+    /// Iterative refinement of the clamped impulses against the regularisation. The solve
+    /// answers (A_CC + εI) x_C = −b_C, which leaves every clamped row the residual velocity
+    /// −ε·x: nothing where impulses are of a size, but a box far heavier than the boxes
+    /// under it makes A_CC's smallest eigenvalue as small as the mass ratio, its weight's
+    /// impulse falls short by ε over that, and it sinks through them at a steady speed. Each step solves the residual again with the same factor, and is
+    /// kept only if it halves the residual (a redundant row's rounding, which no step
+    /// reduces, is left alone) and keeps the sets a solution's.
+    fn refine_clamped(&mut self) {
+        const STEPS: usize = 3;
+        let n = self.b.len();
+        if self.clamped.is_empty() {
+            return;
+        }
+        self.compute_w();
+        let residual = |lcp: &Self| -> f64 {
+            lcp.clamped
+                .iter()
+                .map(|&i| lcp.w[i] - lcp.regularised[i] * lcp.x[i])
+                .map(|r| r * r)
+                .sum::<f64>()
+                .sqrt()
+        };
+        let mut before = residual(self);
+        for _ in 0..STEPS {
+            if before == 0.0 || !before.is_finite() {
+                return;
+            }
+            self.rhs.clear();
+            for &i in &self.clamped {
+                self.rhs
+                    .push(-(self.w[i] - self.regularised[i] * self.x[i]));
+            }
+            self.solve_factor();
+            self.previous.clone_from(&self.x);
+            for (k, &i) in self.clamped.iter().enumerate() {
+                self.x[i] += self.rhs[k];
+            }
+            self.compute_w();
+            let after = residual(self);
+            let scale = self.b.iter().map(|v| v.abs()).fold(0.0, f64::max);
+            let tolerance = CHECK_TOLERANCE * scale;
+            let still_a_solution = (0..n).all(|i| match self.set[i] {
+                Set::Clamped => self.x[i] >= self.lo[i] && self.x[i] <= self.hi[i],
+                Set::Lower => self.w[i] >= -tolerance || self.lo[i] == self.hi[i],
+                Set::Upper => self.w[i] <= tolerance || self.lo[i] == self.hi[i],
+                Set::Unprocessed => true,
+            });
+            if !(after <= 0.5 * before && still_a_solution) {
+                self.x.clone_from(&self.previous);
+                self.compute_w();
+                return;
+            }
+            before = after;
+        }
+    }
+
     /// `w = A x + b`.
     fn compute_w(&mut self) {
         let n = self.b.len();
@@ -450,11 +511,16 @@ impl LcpSolver {
             self.a
                 .extend(row.iter().zip(&self.scale).map(|(a, s)| scale_i * a * s));
         }
+        self.regularised.clear();
         for i in 0..n {
             let bounded = p.lo[i].is_finite() || p.hi[i].is_finite();
-            if bounded || p.friction_index.is_some_and(|f| f[i].is_some()) {
-                self.a[i * n + i] += p.regularisation.max(REGULARISATION);
-            }
+            let added = if bounded || p.friction_index.is_some_and(|f| f[i].is_some()) {
+                p.regularisation.max(REGULARISATION)
+            } else {
+                0.0
+            };
+            self.a[i * n + i] += added;
+            self.regularised.push(added);
         }
         self.load_vectors(p);
     }

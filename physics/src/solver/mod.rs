@@ -1,5 +1,6 @@
 //! Constraint solvers: contacts, the boxed LCP, joints and motors.
 
+pub(crate) mod bounce;
 pub(crate) mod contact;
 pub(crate) mod envelope;
 pub(crate) mod island;

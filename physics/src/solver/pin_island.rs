@@ -219,6 +219,13 @@ impl PinIsland {
         }
     }
 
+    /// Adds `fraction` of the impulses found to the joints' record of what they applied.
+    fn record_impulses(&self, joints: &mut [JointConstraint], fraction: f64) {
+        for (p, j) in joints.iter_mut().enumerate() {
+            j.impulse += Vec2::new(self.psi[2 * p], self.psi[2 * p + 1]) * fraction;
+        }
+    }
+
     /// Applies `fraction` of the impulses found at the joints' present anchors.
     fn apply_impulses(&self, joints: &[JointConstraint], bodies: &mut [SolverBody], fraction: f64) {
         for (p, j) in joints.iter().enumerate() {
@@ -264,7 +271,7 @@ impl PinIsland {
     /// joint's anchors move together. False if the direct solve is impossible.
     pub(super) fn stop_drift(
         &mut self,
-        joints: &[JointConstraint],
+        joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
     ) -> bool {
         self.lay_out(joints, bodies);
@@ -278,6 +285,7 @@ impl PinIsland {
         self.gaps = drift;
         if found {
             self.apply_impulses(joints, bodies, 1.0);
+            self.record_impulses(joints, 1.0);
         }
         found
     }
@@ -288,7 +296,7 @@ impl PinIsland {
     /// tried, and the pass stops if none helps. False if the direct solve is impossible.
     pub(super) fn close_gaps(
         &mut self,
-        joints: &[JointConstraint],
+        joints: &mut [JointConstraint],
         bodies: &mut [SolverBody],
         dt: f64,
         it: &JointIterations,
@@ -316,6 +324,7 @@ impl PinIsland {
                 if now < worst {
                     worst = now;
                     improved = true;
+                    self.record_impulses(joints, fraction);
                     break;
                 }
                 for &(i, b) in &self.saved {

@@ -2,13 +2,14 @@
 //! friction, and the coupled model that solves normals, friction, pins and joint motors in
 //! one boxed LCP whose friction bounds follow the normal impulses.
 
+use super::bounce::{KeptVelocities, bounce_share, gains_energy, mix_velocities};
 use super::contact::{Contact, ContactMemory};
 use super::island::{IslandGrouping, island_ranges};
 use super::joint::JointConstraint;
 use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
 use super::{BodiesAndMoving, SolverBody};
-use crate::math::{Vec2, clamp};
+use crate::math::clamp;
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
 /// dense pivoting method, whose cost grows as n³. Measured by `examples/dense_threshold.rs`
@@ -125,9 +126,12 @@ pub(crate) struct SimultaneousSolver {
     impact_contacts: Vec<(u32, Contact)>,
     /// The (normal, tangent) impulses the impact pass gave each of the island's contacts.
     impact_impulses: Vec<(f64, f64)>,
-    /// The bodies one pair's impact moves, and their velocities before it.
-    touched: Vec<u32>,
-    kept_velocities: Vec<(Vec2, f64)>,
+    /// A bouncing solve's bodies' velocities before it, after it, and after the same
+    /// solve without a bounce, with the bouncing answer's impulses (`bounce`).
+    before_bounce: KeptVelocities,
+    full_bounce: KeptVelocities,
+    inelastic: KeptVelocities,
+    x_full: Vec<f64>,
 }
 
 /// Whether the bodies' velocities already hold the step's forces (`exact`: a contact's
@@ -173,12 +177,14 @@ impl SimultaneousSolver {
             self.load_island(island, contacts, joints);
             self.impact_impulses.clear();
             match model {
-                FrictionModel::TwoStage => self.solve_two_stage(bodies, targets),
+                FrictionModel::TwoStage => {
+                    self.solve_holding_bounce(bodies, targets, Self::solve_two_stage)
+                }
                 FrictionModel::Coupled => {
                     if self.propagate_impacts {
                         self.propagate_impacts(bodies, targets, Kick::Applied);
                     }
-                    self.solve_coupled(bodies, targets);
+                    self.solve_holding_bounce(bodies, targets, Self::solve_coupled);
                 }
             }
             self.write_back(contacts, joints);
@@ -234,6 +240,62 @@ impl SimultaneousSolver {
         }
     }
 
+    /// Runs `solve` on the island (it solves the rows and applies their impulses), holding
+    /// its bounce to the energy the bodies brought (`solver::bounce`): if the answer has
+    /// more, the island is solved again without a bounce and the two answers are mixed.
+    fn solve_holding_bounce(
+        &mut self,
+        bodies: &mut [SolverBody],
+        targets: &VelocityTargets,
+        solve: fn(&mut Self, &mut [SolverBody], &VelocityTargets),
+    ) {
+        let (dt, below) = (targets.dt, targets.bounce_below);
+        if !self
+            .island_contacts
+            .iter()
+            .any(|(_, c)| c.bounces(dt, below))
+        {
+            solve(self, bodies, targets);
+            return;
+        }
+        let contact_ends = self
+            .island_contacts
+            .iter()
+            .map(|(_, c)| (c.body_a.0, c.body_b.0));
+        let joint_ends = self.island_joints.iter().map(|j| (j.body_a, j.body_b));
+        let ends = contact_ends.chain(joint_ends).flat_map(|(a, b)| [a, b]);
+        self.before_bounce.keep(bodies, ends);
+        let brought = self.before_bounce.kinetic_energy(bodies);
+        solve(self, bodies, targets);
+        self.full_bounce.keep_like(&self.before_bounce, bodies);
+        let bounced = self.full_bounce.kinetic_energy(bodies);
+        if !gains_energy(brought, bounced) {
+            return;
+        }
+        self.x_full.clear();
+        self.x_full.extend_from_slice(&self.x);
+        self.before_bounce.restore(bodies);
+        let inelastic = VelocityTargets {
+            bounce_below: f64::INFINITY,
+            ..*targets
+        };
+        solve(self, bodies, &inelastic);
+        self.reports.pop(); // the island's report is the first solve's
+        self.inelastic.keep_like(&self.before_bounce, bodies);
+        // Where motors work, the solve without a bounce may leave more than was brought.
+        let allowed = brought.max(self.inelastic.kinetic_energy(bodies));
+        if !gains_energy(allowed, bounced) {
+            self.full_bounce.restore(bodies);
+            self.x.copy_from_slice(&self.x_full);
+            return;
+        }
+        let s = bounce_share(&self.inelastic, &self.full_bounce, bodies, allowed);
+        mix_velocities(&self.inelastic, &self.full_bounce, s, bodies);
+        for (x, &full) in self.x.iter_mut().zip(&self.x_full) {
+            *x += (full - *x) * s;
+        }
+    }
+
     /// Starting impulses for the rows from the last solve's, for contacts that persist.
     fn remember(&mut self) {
         self.guess.clear();
@@ -252,7 +314,8 @@ impl SimultaneousSolver {
     /// Removes penetration deeper than `slop` without adding energy (split impulse): the
     /// normal rows, with the pins as equality rows so the push cannot open them, are solved
     /// for pseudo-velocities that move `bodies`' positions and angles only. Each step
-    /// removes the fraction `rate` of the excess depth.
+    /// removes the fraction `rate` of the excess depth, moving no contact point faster
+    /// than `max_push` (length per second).
     pub(crate) fn separate(
         &mut self,
         contacts: &[Contact],
@@ -260,7 +323,7 @@ impl SimultaneousSolver {
         (bodies, moving): BodiesAndMoving<'_>,
         dt: f64,
         slop: f64,
-        rate: f64,
+        (rate, max_push): (f64, f64),
     ) {
         let mut contacts_copy = std::mem::take(&mut self.scratch_contacts);
         contacts_copy.clear();
@@ -297,7 +360,6 @@ impl SimultaneousSolver {
             dt,
             bounce_below: f64::INFINITY,
             friction: false,
-            close_joint_gaps: false,
         };
         self.regularisation = POSITION_REGULARISATION;
         for island in 0..self.ranges.len() {
@@ -321,7 +383,7 @@ impl SimultaneousSolver {
                 }
             }
             self.solve_rows(&mut pseudo, true);
-            self.limit_separation(&mut pseudo, dt, slop);
+            self.limit_separation(&mut pseudo, dt, slop, max_push);
         }
         // Only the moving bodies have a pseudo-velocity.
         for &i in moving {
@@ -335,16 +397,18 @@ impl SimultaneousSolver {
     }
 
     /// Scales the island's pseudo-velocities down so that no contact point moves more
-    /// than twice the deepest excess penetration: a push the pins forbid (two pinned
-    /// bodies that overlap and may collide) has no solution, and the solve's answer to
-    /// it threw such a pair 164 m in one step.
-    fn limit_separation(&self, pseudo: &mut [SolverBody], dt: f64, slop: f64) {
+    /// than twice the deepest excess penetration, nor faster than `max_push`: a push the
+    /// pins forbid (two pinned bodies that overlap and may collide) has no solution, and
+    /// the solve's answer to it would throw such a pair far away; and bodies placed deep
+    /// in each other part gently, turning little enough in a step that their pins, held to
+    /// first order by the pass, stay closed to second.
+    fn limit_separation(&self, pseudo: &mut [SolverBody], dt: f64, slop: f64, max_push: f64) {
         let deepest = self
             .island_contacts
             .iter()
             .map(|(_, c)| c.depth - slop)
             .fold(0.0, f64::max);
-        let allowed = 2.0 * deepest;
+        let allowed = (2.0 * deepest).min(max_push * dt);
         let moved = self
             .island_contacts
             .iter()
@@ -480,10 +544,6 @@ impl SimultaneousSolver {
         }
         self.impact_impulses
             .resize(self.island_contacts.len(), (0.0, 0.0));
-        let impact_targets = VelocityTargets {
-            close_joint_gaps: false,
-            ..*targets
-        };
         let mut budget = IMPACT_SOLVES_PER_PAIR * self.pair_spans.len();
         'sweeps: loop {
             let mut any = false;
@@ -500,7 +560,7 @@ impl SimultaneousSolver {
                     break 'sweeps;
                 }
                 budget -= 1;
-                if !self.solve_impact_pair(p, bodies, &impact_targets) {
+                if !self.solve_impact_pair(p, bodies, targets) {
                     break 'sweeps;
                 }
                 any = true;
@@ -510,10 +570,19 @@ impl SimultaneousSolver {
                 break;
             }
         }
+        // The pairs that bounced only keep apart in the island's solve; the others meet it
+        // as the impacts passed on left them.
         for (p, &(start, end)) in self.pair_spans.iter().enumerate() {
-            if self.bounced[p] {
-                for (_, c) in &mut self.island_contacts[start..end] {
+            for (_, c) in &mut self.island_contacts[start..end] {
+                if self.bounced[p] {
                     c.approach_velocity = 0.0;
+                } else {
+                    let now = c.relative_velocity(bodies).dot(&c.normal);
+                    let forces = c.normal_velocity - c.approach_velocity;
+                    (c.approach_velocity, c.normal_velocity) = match kick {
+                        Kick::Applied => (now - forces, now),
+                        Kick::Pending => (now, now + forces),
+                    };
                 }
             }
         }
@@ -567,54 +636,41 @@ impl SimultaneousSolver {
         targets: &VelocityTargets,
     ) -> bool {
         let (start, end) = self.pair_spans[p];
-        velocity_rows(
-            &self.impact_contacts,
-            &self.impact_joints,
-            bodies,
-            targets,
-            &mut self.rows,
-        );
-        for row in self.rows.iter_mut() {
-            if matches!(row.kind, RowKind::JointX(_) | RowKind::JointY(_)) {
-                row.b = 0.0;
-            }
-        }
-        self.guess.clear();
-        self.solve_rows_dense(bodies);
-        // A bounce of cor ≤ 1 adds no kinetic energy (a face's two points, each reflecting
-        // its own approach, may add a few millionths). A pair whose rows contradict its pins
-        // (two pinned bodies that overlap and may collide) has no such solution, and an
-        // answer that adds more than a thousandth is refused: the island's own solve takes
-        // the pair, as without the pass.
-        self.touched.clear();
-        self.touched
-            .extend(self.rows.iter().flat_map(|r| r.ends.iter().map(|e| e.body)));
-        self.touched.sort_unstable();
-        self.touched.dedup();
-        let energy = |bodies: &[SolverBody], touched: &[u32]| -> f64 {
-            touched
-                .iter()
-                .map(|&i| bodies[i as usize].kinetic_energy())
-                .sum()
-        };
-        let before = energy(bodies, &self.touched);
-        self.kept_velocities.clear();
-        self.kept_velocities.extend(self.touched.iter().map(|&i| {
-            (
-                bodies[i as usize].velocity,
-                bodies[i as usize].angular_velocity,
-            )
-        }));
+        self.solve_impact_rows(bodies, targets);
+        let ends = self.rows.iter().flat_map(|r| r.ends.iter().map(|e| e.body));
+        self.before_bounce.keep(bodies, ends);
+        let brought = self.before_bounce.kinetic_energy(bodies);
         for (row, &x) in self.rows.iter().zip(&self.x) {
             row.apply(bodies, x);
         }
-        let after = energy(bodies, &self.touched);
-        if !after.is_finite() || after > before * (1.0 + 1e-3) {
-            for (&i, &(v, w)) in self.touched.iter().zip(&self.kept_velocities) {
-                bodies[i as usize].velocity = v;
-                bodies[i as usize].angular_velocity = w;
-            }
+        self.full_bounce.keep_like(&self.before_bounce, bodies);
+        let bounced = self.full_bounce.kinetic_energy(bodies);
+        if !bounced.is_finite() {
+            self.before_bounce.restore(bodies);
             return false;
+        }
+        if gains_energy(brought, bounced) {
+            // A face's two points, each reflecting its own approach, or a pair whose rows
+            // contradict its pins (two pinned bodies that overlap and may collide): the
+            // bounce is held to what the pair brought (`solver::bounce`).
+            self.x_full.clear();
+            self.x_full.extend_from_slice(&self.x);
+            self.before_bounce.restore(bodies);
+            let inelastic = VelocityTargets {
+                bounce_below: f64::INFINITY,
+                ..*targets
+            };
+            self.solve_impact_rows(bodies, &inelastic);
+            for (row, &x) in self.rows.iter().zip(&self.x) {
+                row.apply(bodies, x);
+            }
+            self.inelastic.keep_like(&self.before_bounce, bodies);
+            let allowed = brought.max(self.inelastic.kinetic_energy(bodies));
+            let s = bounce_share(&self.inelastic, &self.full_bounce, bodies, allowed);
+            mix_velocities(&self.inelastic, &self.full_bounce, s, bodies);
+            for (x, &full) in self.x.iter_mut().zip(&self.x_full) {
+                *x += (full - *x) * s;
+            }
         }
         for (row, &x) in self.rows.iter().zip(&self.x) {
             let local = |i: u32| {
@@ -638,6 +694,26 @@ impl SimultaneousSolver {
             }
         }
         true
+    }
+
+    /// The impact pass's rows for the pair in `impact_contacts`, solved into `x` (not
+    /// applied): its normals and friction with the island's pins, which keep their
+    /// velocities as they are.
+    fn solve_impact_rows(&mut self, bodies: &[SolverBody], targets: &VelocityTargets) {
+        velocity_rows(
+            &self.impact_contacts,
+            &self.impact_joints,
+            bodies,
+            targets,
+            &mut self.rows,
+        );
+        for row in self.rows.iter_mut() {
+            if matches!(row.kind, RowKind::JointX(_) | RowKind::JointY(_)) {
+                row.b = 0.0;
+            }
+        }
+        self.guess.clear();
+        self.solve_rows_dense(bodies);
     }
 
     fn solve_coupled(&mut self, bodies: &mut [SolverBody], targets: &VelocityTargets) {
@@ -806,7 +882,12 @@ impl SimultaneousSolver {
                         m.last_impulse = x;
                     }
                 }
-                RowKind::JointX(_) | RowKind::JointY(_) => {}
+                RowKind::JointX(k) => {
+                    joints[self.joint_slots[k as usize] as usize].impulse.x += x;
+                }
+                RowKind::JointY(k) => {
+                    joints[self.joint_slots[k as usize] as usize].impulse.y += x;
+                }
             }
         }
         // What the impact pass gave a contact is part of its impulse this step.

@@ -106,9 +106,6 @@ pub(crate) struct VelocityTargets {
     pub bounce_below: f64,
     /// Whether friction rows are included (the thesis's first stage solves normals alone).
     pub friction: bool,
-    /// Whether pin rows also close the current gap this step (the thesis's prediction, SPEC
-    /// eq. 34–39, solved together with the contacts).
-    pub close_joint_gaps: bool,
 }
 
 /// Builds the velocity-level rows of one island.
@@ -177,14 +174,15 @@ pub(crate) fn velocity_rows(
         let (a, b) = (&bodies[j.body_a as usize], &bodies[j.body_b as usize]);
         let (r_a, r_b) = j.arms((a.angle, b.angle));
         let (p_a, p_b) = (a.position + r_a, b.position + r_b);
-        let gap = if targets.close_joint_gaps {
-            (p_a - p_b - j.gap_target) / targets.dt
-        } else {
-            Vec2::zeros()
-        };
-        for (kind, dir, bias) in [
-            (RowKind::JointX(k as u32), Vec2::new(1.0, 0.0), gap.x),
-            (RowKind::JointY(k as u32), Vec2::new(0.0, 1.0), gap.y),
+        // A pin's rows ask only that its anchors stop drifting apart: the velocity solve
+        // asks nothing of the bodies that they did not bring, so it adds no energy. Its
+        // gap is closed by the pins' own position pass after it (`joint_block`), apart
+        // from the contacts: asked of the same solve, a gap that a contact forbids closing
+        // (two pinned bodies overlapping) makes the rows contradict each other, and the
+        // solve's answer to that is energy from nothing.
+        for (kind, dir) in [
+            (RowKind::JointX(k as u32), Vec2::new(1.0, 0.0)),
+            (RowKind::JointY(k as u32), Vec2::new(0.0, 1.0)),
         ] {
             let ends = point_row(j.body_a, j.body_b, p_a, p_b, dir, bodies);
             let mut row = Row {
@@ -195,7 +193,7 @@ pub(crate) fn velocity_rows(
                 hi: f64::INFINITY,
                 friction_of: None,
             };
-            row.b = row.velocity(bodies) + bias;
+            row.b = row.velocity(bodies);
             rows.push(row);
         }
         if let Some(m) = j.motor.filter(|m| m.enabled) {
@@ -303,12 +301,12 @@ mod tests {
             local_anchor_b: Vec2::new(-0.6, -0.3),
             motor: None,
             gap_target: Vec2::zeros(),
+            impulse: Vec2::zeros(),
         }];
         let targets = VelocityTargets {
             dt: 0.01,
             bounce_below: 0.0,
             friction: true,
-            close_joint_gaps: false,
         };
         let mut rows = vec![];
         velocity_rows(&contacts, &joints, &bodies, &targets, &mut rows);

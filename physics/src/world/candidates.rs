@@ -18,6 +18,17 @@ const MAX_NEIGHBOURS: f64 = 32.0;
 /// (`FixedCells`) and only the moving bodies are gridded at each pairing.
 const FIXED_CELLS_FROM: usize = 64;
 
+/// Whether a convex outline (vertices in positive order) covers `point`, its boundary
+/// included.
+fn covers_point(vertices: &[crate::math::Vec2], point: crate::math::Vec2) -> bool {
+    let n = vertices.len();
+    let size = vertices.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    (0..n).all(|i| {
+        let (a, b) = (vertices[i], vertices[(i + 1) % n]);
+        crate::math::cross(b - a, point - a) >= -1e-9 * size * size
+    })
+}
+
 /// How much of body `i`'s room for neighbours body `j` takes: 1 for a body at least its
 /// size, by bounding radius, and less for a smaller one.
 fn neighbour_share(radii: &[f64], i: usize, j: usize) -> f64 {
@@ -175,6 +186,7 @@ impl World {
         );
         self.jointed.sort_unstable();
         self.jointed.dedup();
+        let pivot_sharers = self.pairs_sharing_a_pivot();
         self.non_colliding.rebuild(
             self.joints
                 .iter()
@@ -184,8 +196,76 @@ impl World {
                     let (a, b) = (j.body_a.0, j.body_b?.0);
                     Some((a.min(b), a.max(b)))
                 })
-                .chain(self.ignored_pairs.iter().copied()),
+                .chain(self.ignored_pairs.iter().copied())
+                .chain(pivot_sharers),
         );
+    }
+
+    /// The body pairs that turn about one pivot, each covering it: two bodies pinned to a
+    /// third (or to the static world, or to static bodies: the world) at the same point of
+    /// it, each containing that point.
+    /// However they turn they overlap there, so no contact between them can ever be
+    /// resolved, and a solver that tried would push them against their pins for ever.
+    /// Like two pinned bodies, they pass through each other: scissors' blades, a walker's
+    /// legs on one hip, a wheel's spokes. A joint that asks its bodies to collide
+    /// (`collide_connected`) keeps its bodies out of this.
+    fn pairs_sharing_a_pivot(&self) -> Vec<(u32, u32)> {
+        const WORLD: u32 = u32::MAX;
+        let covers = |body: u32, local: crate::math::Vec2| {
+            self.bodies[body as usize]
+                .as_ref()
+                .is_some_and(|b| covers_point(b.local_vertices(), local))
+        };
+        // A pivot's holder and the pivot in its frame; a static body's pivots are the
+        // world's, at their world points.
+        let holder = |body: Option<u32>, local: crate::math::Vec2| match body
+            .and_then(|i| Some((i, self.bodies[i as usize].as_ref()?)))
+        {
+            Some((_, b)) if b.is_static() => (
+                WORLD,
+                b.position + crate::math::Rot::new(b.angle).apply(local),
+            ),
+            Some((i, _)) => (i, local),
+            None => (WORLD, local),
+        };
+        // (pivot's holder, the pivot in its holder's frame, the body turning about it)
+        let mut pivots: Vec<(u32, crate::math::Vec2, u32)> = Vec::new();
+        for j in self
+            .joints
+            .iter()
+            .flatten()
+            .filter(|j| !j.collide_connected)
+        {
+            let (a, b) = (j.body_a.0, j.body_b.map(|h| h.0));
+            if covers(a, j.local_anchor_a) {
+                let (held_by, at) = holder(b, j.local_anchor_b);
+                pivots.push((held_by, at, a));
+            }
+            if let Some(b) = b.filter(|&b| covers(b, j.local_anchor_b)) {
+                let (held_by, at) = holder(Some(a), j.local_anchor_a);
+                pivots.push((held_by, at, b));
+            }
+        }
+        pivots.sort_unstable_by(|p, q| p.0.cmp(&q.0).then(p.1.x.total_cmp(&q.1.x)));
+        let mut pairs = Vec::new();
+        for (k, &(holder, at, body)) in pivots.iter().enumerate() {
+            // The same point to a millionth of the holder's size: anchors made from one
+            // point of a file agree far closer.
+            let size = match self.bodies.get(holder as usize).and_then(Option::as_ref) {
+                Some(b) => b.bounding_radius(),
+                None => at.norm().max(1.0),
+            };
+            let tolerance = 1e-6 * size;
+            for &(other_holder, other_at, other) in &pivots[k + 1..] {
+                if other_holder != holder || other_at.x - at.x > tolerance {
+                    break;
+                }
+                if other != body && (other_at - at).norm() <= tolerance {
+                    pairs.push((body.min(other), body.max(other)));
+                }
+            }
+        }
+        pairs
     }
 
     /// World outlines, each body's reach this step and poses, and the broad phase's

@@ -19,11 +19,11 @@ pub(super) struct ContinuousScratch {
     mover_at_end: WorldPolygon,
     mover_at_start: WorldPolygon,
     toi_scratch: WorldPolygon,
-    /// The bodies stopped and their times of impact; joint islands and each island's
-    /// earliest impact.
-    impacts: Vec<(u32, f64)>,
+    /// The bodies stopped, their times of impact and whether they sank (`Stop`); joint
+    /// islands and each island's earliest stop.
+    impacts: Vec<(u32, Stop)>,
     impact_union: UnionFind,
-    island_impact: Vec<f64>,
+    island_impact: Vec<Stop>,
 }
 
 /// The static bodies as obstacles, kept while the sets stay: each one's slot, outline,
@@ -40,6 +40,26 @@ pub(super) struct Obstacles {
     wide: Vec<u32>,
     widths: Vec<f64>,
     seen: EpochSeen,
+}
+
+/// Where continuous collision stops a body: the fraction of its step's sweep, and
+/// whether it came from apart (an impact, which the contacts bounce next step) or sank
+/// from contact (the contact solver did not hold it: it moves on only as far as it got).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Stop {
+    t: f64,
+    sank: bool,
+}
+
+impl Stop {
+    const NONE: Stop = Stop {
+        t: f64::INFINITY,
+        sank: false,
+    };
+
+    fn earlier(self, other: Stop) -> Stop {
+        if other.t < self.t { other } else { self }
+    }
 }
 
 /// An obstacle this many times wider than the median one is not in the index by left
@@ -123,7 +143,7 @@ impl Obstacles {
 
 impl World {
     /// Continuous collision: see `step`.
-    pub(super) fn stop_at_impact(&mut self) {
+    pub(super) fn stop_at_impact(&mut self, dt: f64) {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch.continuous;
@@ -170,7 +190,7 @@ impl World {
             // first needs them: most fast bodies have none near, and placing both for
             // every fast body is a noticeable part of a scene of flying debris's step.
             let (mut placed_at_end, mut placed_at_start) = (false, false);
-            let mut first: Option<f64> = None;
+            let mut first: Option<Stop> = None;
             for (obstacle, polygon, _, _) in obstacles.near(&swept) {
                 // A static body this one never collides with (a robot's pivot that its
                 // own links pass over) is no obstacle.
@@ -212,11 +232,12 @@ impl World {
                     0.25 * slop,
                     &mut s.toi_scratch,
                 )
+                .map(|t| Stop { t, sank: false })
                 .or_else(|| {
                     if end_gap >= -2.0 * slop {
                         return None;
                     }
-                    time_of_sinking(
+                    let t = time_of_sinking(
                         local,
                         radius,
                         &sweep,
@@ -224,18 +245,19 @@ impl World {
                         2.0 * slop,
                         0.25 * slop,
                         &mut s.toi_scratch,
-                    )
+                    )?;
+                    Some(Stop { t, sank: true })
                 });
-                if let Some(t) = hit {
-                    first = Some(first.map_or(t, |f: f64| f.min(t)));
+                if let Some(hit) = hit {
+                    first = Some(first.map_or(hit, |f| f.earlier(hit)));
                 }
             }
-            if let Some(t) = first {
-                s.impacts.push((i as u32, t));
+            if let Some(stop) = first {
+                s.impacts.push((i as u32, stop));
             }
         }
         self.obstacles = obstacles;
-        self.move_back_to_impacts();
+        self.move_back_to_impacts(dt);
     }
 
     /// Moves each body that continuous collision stopped back along its sweep to its time
@@ -243,7 +265,15 @@ impl World {
     /// same fraction of its own sweep: moving one link alone would open its pins by the
     /// rest of the step's motion. (Turning bodies' pins then stay together to second order
     /// in the step's rotation; the joint passes close the rest next step.)
-    fn move_back_to_impacts(&mut self) {
+    ///
+    /// A body that came from apart keeps its velocity: the contacts meet the impact next
+    /// step and bounce it. One that sank from contact moves on with the velocity it
+    /// actually moved with, the fraction of its sweep it kept over the step: its velocity
+    /// into the obstacle is what the contact solver failed to stop, and kept, it would
+    /// send the body back into the obstacle, and back to the same place, step after step,
+    /// gaining speed from gravity while it does not move (a hub of 20 pinned spokes on a
+    /// floor under `thesis`).
+    fn move_back_to_impacts(&mut self, dt: f64) {
         let s = &mut self.scratch.continuous;
         if s.impacts.is_empty() {
             return;
@@ -265,28 +295,32 @@ impl World {
                 }
             }
             s.island_impact.clear();
-            s.island_impact.resize(bodies.len(), f64::INFINITY);
-            for &(i, t) in &s.impacts {
+            s.island_impact.resize(bodies.len(), Stop::NONE);
+            for &(i, stop) in &s.impacts {
                 let root = s.impact_union.find(i) as usize;
-                s.island_impact[root] = s.island_impact[root].min(t);
+                s.island_impact[root] = s.island_impact[root].earlier(stop);
             }
             s.impacts.clear();
             for i in 0..bodies.len() {
                 if moving(i) {
-                    let t = s.island_impact[s.impact_union.find(i as u32) as usize];
-                    if t.is_finite() {
-                        s.impacts.push((i as u32, t));
+                    let stop = s.island_impact[s.impact_union.find(i as u32) as usize];
+                    if stop.t.is_finite() {
+                        s.impacts.push((i as u32, stop));
                     }
                 }
             }
         }
-        for &(i, t) in &s.impacts {
+        for &(i, stop) in &s.impacts {
             let body = bodies[i as usize].as_mut().expect("a moving body");
             let sweep = Sweep {
                 start: s.step_start[i as usize],
                 end: (body.position, body.angle),
             };
-            (body.position, body.angle) = sweep.at(t);
+            (body.position, body.angle) = sweep.at(stop.t);
+            if stop.sank {
+                body.velocity = (body.position - sweep.start.0) / dt;
+                body.angular_velocity = (body.angle - sweep.start.1) / dt;
+            }
         }
     }
 }

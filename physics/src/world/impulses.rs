@@ -4,6 +4,7 @@
 //! finer.
 
 use super::{Pipeline, World};
+use crate::math::Vec2;
 use crate::solver::contact::{restitution_threshold, solve_sequential};
 use crate::solver::joint::JointMotor;
 use crate::solver::joint::{JointConstraint, JointIterations};
@@ -12,12 +13,27 @@ use crate::solver::simultaneous::FrictionModel;
 use crate::solver::system::VelocityTargets;
 use crate::solver::{BodiesAndMoving, ImpulseMethod};
 
-/// At most this many substeps per step (see `World::substeps_for`).
-const MAX_SUBSTEPS: usize = 8;
+/// At most this many substeps per step, where fast turns (`World::substeps_for`) or the
+/// pins' pull (`World::substeps_for_tension`) ask for them: enough for a light chain
+/// whipping a load 10,000 times heavier at h = 1/60.
+const MAX_SUBSTEPS: usize = 64;
+
+/// The most substeps a step is taken again with because a pin ended it wider than a
+/// thousandth of the length scale, where the pins are solved apart from the contacts
+/// (`thesis`, `sequential`): a contact pushing a pinned body holds its pin open however
+/// fine the substeps, and a car pushing a pyramid would cost the most substeps every
+/// step. Where they are solved together (`exact`) finer substeps close what the
+/// prediction missed, up to `MAX_SUBSTEPS` (docs/bench/profile.md, "Substeps for pins").
+const GAP_SUBSTEPS_APART: usize = 8;
 
 /// Fraction of the excess penetration the split-impulse pass removes per step: all of it
 /// at once overshoots in stacks, where pushes add up along the column.
 const SPLIT_IMPULSE_RATE: f64 = 0.4;
+
+/// The fastest the split-impulse pass moves a contact point apart, in length scales per
+/// second: bodies placed deep in each other part over several steps, as Box2D v3's
+/// contacts push apart no faster than 3 m/s for its metre-sized bodies.
+const SPLIT_IMPULSE_MAX_PUSH: f64 = 3.0;
 
 impl World {
     /// The impulse stage list: joints repaired, then substeps of joint correction,
@@ -25,12 +41,13 @@ impl World {
     /// finer substeps where a joint's prediction was not to be trusted.
     pub(super) fn step_impulses(&mut self, method: ImpulseMethod, dt: f64) {
         self.repair_broken_joints(dt);
-        let mut substeps = self.substeps_for(dt);
+        let mut substeps = self.substeps_for(dt).max(self.tension_substeps);
         // A joint still broken is being repaired on purpose over several steps; only
         // joints that should have closed ask for finer substeps.
         let repairing = self.max_joint_gap() > self.settings.joint_iterations(dt).broken_gap;
         loop {
             self.save_state();
+            self.scratch.pin_impulses.fill(Vec2::zeros());
             let h = dt / substeps as f64;
             self.for_each_motor(|m| m.step_impulse = 0.0);
             self.stats.impulse_substeps += substeps as u64;
@@ -50,16 +67,73 @@ impl World {
             }
             // A whip can spin links up within the step; if they now turn too far per
             // substep, this step's joint prediction was not trustworthy: redo it finer.
-            let mut needed = self.substeps_for(dt);
-            if !repairing && self.max_joint_gap() > 1e-3 * self.settings.length_scale {
+            let tension = self.substeps_for_tension(dt);
+            let mut needed = self.substeps_for(dt).max(tension);
+            let pins_apart = method.pushes_apart();
+            if !repairing
+                && (!pins_apart || substeps < GAP_SUBSTEPS_APART)
+                && self.max_joint_gap() > 1e-3 * self.settings.length_scale
+            {
                 needed = needed.max(2 * substeps);
             }
             if needed <= substeps || substeps >= MAX_SUBSTEPS {
+                self.tension_substeps = tension;
                 break;
             }
             self.restore_state();
             substeps = needed.max(2 * substeps).min(MAX_SUBSTEPS);
         }
+    }
+
+    /// How many substeps the pins' pull asks for (from this step's pin impulses). A pin
+    /// pulling body b with force F at arm r (from b's centroid) turns b back towards the
+    /// pull's line with a stiffness F·r per radian: the string's stiffness that holds a
+    /// hanging chain straight. The solve takes each pin force's direction from the start
+    /// of the substep, so for this stiffness it is explicit, and stable only while
+    /// ω·h < 2, ω² = Σ F·r / I over b's pins: past it, light links holding a heavy load
+    /// shake themselves apart from round-off. The
+    /// estimate bounds the chain's fastest zigzag from above (by about 2 for a uniform
+    /// link, whose neighbours give way), and a substep is kept at ω·h ≤ 2 by it.
+    pub(super) fn substeps_for_tension(&mut self, dt: f64) -> usize {
+        const MAX_STIFF_TURN: f64 = 2.0;
+        let s = &mut self.scratch;
+        s.pull_stiffness.clear();
+        s.pull_stiffness.resize(self.bodies.len(), 0.0);
+        let mut any = false;
+        for (j, impulse) in self.joints.iter().zip(&s.pin_impulses) {
+            let Some(j) = j else { continue };
+            if *impulse == Vec2::zeros() {
+                continue;
+            }
+            let force = impulse / dt;
+            let ends = [
+                (Some(j.body_a), j.local_anchor_a, 1.0),
+                (j.body_b, j.local_anchor_b, -1.0),
+            ];
+            for (handle, local, sign) in ends {
+                let Some(body) = handle.and_then(|h| self.bodies[h.index()].as_ref()) else {
+                    continue;
+                };
+                let arm = crate::math::Rot::new(body.angle).apply(local);
+                let pull = (force * sign).dot(&arm);
+                if pull > 0.0 {
+                    s.pull_stiffness[handle.expect("a body").index()] += pull;
+                    any = true;
+                }
+            }
+        }
+        if !any {
+            return 1;
+        }
+        let fastest = self
+            .sets
+            .moving()
+            .iter()
+            .filter_map(|&i| Some((i, self.bodies[i as usize].as_ref()?)))
+            .map(|(i, b)| s.pull_stiffness[i as usize] * b.inv_inertia)
+            .fold(0.0, f64::max)
+            .sqrt();
+        ((fastest * dt / MAX_STIFF_TURN).ceil() as usize).clamp(1, MAX_SUBSTEPS)
     }
 
     pub(super) fn for_each_motor(&mut self, f: impl Fn(&mut JointMotor)) {
@@ -227,7 +301,6 @@ impl World {
             dt,
             bounce_below: restitution_threshold(self.gravity, dt),
             friction: true,
-            close_joint_gaps: true,
         };
         match method {
             ImpulseMethod::Sequential => {
@@ -274,7 +347,10 @@ impl World {
                 self.inputs.bodies_and_moving(self.sets.moving()),
                 dt,
                 self.settings.slop(),
-                SPLIT_IMPULSE_RATE,
+                (
+                    SPLIT_IMPULSE_RATE,
+                    SPLIT_IMPULSE_MAX_PUSH * self.settings.length_scale,
+                ),
             );
         }
         self.scatter_solver_bodies();

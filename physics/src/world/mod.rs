@@ -122,6 +122,18 @@ pub enum StepError {
         "gravity carries a body {fall:e} from rest in one step, more than {limit:e} ({FALL_PER_STEP} length scales): bodies would fall through each other; take a smaller step"
     )]
     FallsTooFar { fall: f64, limit: f64 },
+    /// A joint motor asks for more than half a turn a step (`limits::ANGULAR`), which no
+    /// step can show nor any solver follow.
+    #[error(
+        "joint {joint}'s motor asks for {speed:e} rad/s, {turn:.3e} rad a step at this step: more than half a turn (π) a step"
+    )]
+    MotorTooFast { joint: u32, speed: f64, turn: f64 },
+    /// The step tore a pin open wider than twice the length scale: a force, a motor or a
+    /// collision the step cannot follow. The world's state is not to be trusted.
+    #[error(
+        "joint {joint} was torn {gap:.3e} apart in one step (more than {limit:.3e}, twice the length scale): a force or motor faster than the step can follow"
+    )]
+    PinTorn { joint: u32, gap: f64, limit: f64 },
     /// The step ended with a body's state non-finite or beyond `crate::limits` (an
     /// absurd force, a collapse no solver can hold): the world's state is not to be
     /// trusted, and further steps are pointless.
@@ -195,6 +207,9 @@ pub struct World {
     sleep_labels: Vec<u32>,
     /// What `auto` keeps from step to step.
     auto: AutoMemory,
+    /// The substeps the pins' pull asked for in the last step of the impulse stage list
+    /// (`World::substeps_for_tension`): the next step starts there.
+    tension_substeps: usize,
     /// The world's own counts of `StepStats` (the soft step keeps its own).
     stats: StepStats,
     /// The ticks each stage of the last step took (`World::profile`).
@@ -254,7 +269,14 @@ struct Scratch {
     turn_off: Vec<f64>,
     /// Poses and velocities at the start of the step, to redo it with finer substeps.
     saved_state: Vec<(Vec2, f64, Vec2, f64)>,
+    /// Each joint's gap before the step, by slot (`World::check_pins_held`).
+    gaps_before: Vec<Option<f64>>,
     joint_constraints: Vec<JointConstraint>,
+    /// Each joint's impulse on body A so far this step, by joint slot (what its
+    /// `JointConstraint::impulse` gathered in each pass), and each body's stiffness from
+    /// its pins' pull (`World::substeps_for_tension`).
+    pin_impulses: Vec<Vec2>,
+    pull_stiffness: Vec<f64>,
     sleeping: SleepScratch,
     continuous: ContinuousScratch,
     auto: AutoScratch,
@@ -543,12 +565,57 @@ impl World {
         if fall > limit {
             return Err(StepError::FallsTooFar { fall, limit });
         }
+        self.check_motor_speeds(dt)?;
+        let mut gaps_before = std::mem::take(&mut self.scratch.gaps_before);
+        gaps_before.clear();
+        gaps_before.extend((0..self.joints.len()).map(|k| self.joint_gap(JointHandle(k as u32))));
         self.profile = StepProfile::default();
         let started = stage_clock::mark();
         self.advance(dt);
         self.profile.take_from(&mut self.solvers.soft.profile);
         self.profile.record(Stage::Step, started);
+        let torn = self.check_pins_held(&gaps_before);
+        self.scratch.gaps_before = gaps_before;
+        torn?;
         self.check_state()
+    }
+
+    /// Every enabled joint motor asks for at most half a turn a step.
+    fn check_motor_speeds(&self, dt: f64) -> Result<(), StepError> {
+        for (k, joint) in self.joints.iter().enumerate() {
+            let Some(m) = joint.and_then(|j| j.motor).filter(|m| m.enabled) else {
+                continue;
+            };
+            let turn = m.target_speed * dt;
+            if turn.abs() > crate::limits::ANGULAR {
+                return Err(StepError::MotorTooFast {
+                    joint: k as u32,
+                    speed: m.target_speed,
+                    turn,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// No pin was torn wider than twice the length scale by the step (`StepError::PinTorn`);
+    /// one that was that wide before it (a robot placed with its pins apart, being
+    /// repaired) only may not widen.
+    fn check_pins_held(&self, gaps_before: &[Option<f64>]) -> Result<(), StepError> {
+        let limit = 2.0 * self.settings.length_scale;
+        for (k, before) in gaps_before.iter().enumerate() {
+            let Some(gap) = self.joint_gap(JointHandle(k as u32)) else {
+                continue;
+            };
+            if gap > limit && gap > before.unwrap_or(0.0) || gap.is_nan() {
+                return Err(StepError::PinTorn {
+                    joint: k as u32,
+                    gap,
+                    limit,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Every moving body's state finite and within `crate::limits`.
@@ -599,7 +666,7 @@ impl World {
         self.step_count += 1;
         if self.settings.continuous {
             let started = stage_clock::mark();
-            self.stop_at_impact();
+            self.stop_at_impact(dt);
             self.profile.record(Stage::Continuous, started);
         }
         if self.settings.sleeping {

@@ -49,6 +49,14 @@ impl World {
                 .iter()
                 .any(|c| c.restitution > 0.0 && moves(c.body_a.0) && moves(c.body_b.0));
         let found = may_bounce.then(|| self.contacts.clone());
+        if may_bounce {
+            self.solvers.soft.keep_for_another_try();
+        }
+        let substeps = self
+            .settings
+            .soft_substeps
+            .max(1)
+            .max(self.soft_substeps_for_spin(dt));
         let mut unforeseen = Vec::new();
         loop {
             if may_bounce {
@@ -60,7 +68,7 @@ impl World {
             }
             self.solvers.soft.step(
                 &SoftSettings {
-                    substeps: self.settings.soft_substeps.max(1),
+                    substeps,
                     alternating_sweeps: self.settings.soft_alternating_sweeps,
                     ..SoftSettings::for_length_scale(self.settings.length_scale)
                 },
@@ -79,9 +87,32 @@ impl World {
                 break;
             }
             self.contacts.clone_from(found);
+            self.solvers.soft.take_again();
             self.gather_solver_bodies_with(GapTargets::None);
         }
         self.scatter_solver_bodies();
+    }
+
+    /// The substeps the step's fastest turn asks for: a body turning faster than a
+    /// quarter turn a substep would be held back to it by the soft step, silently, and a
+    /// pin on a body turning that far in a substep opens. Each substep turns at most an
+    /// eighth of a turn: the bodies' spins and the joint motors' speeds at the step's
+    /// start, up to `MAX_SOFT_SUBSTEPS`.
+    fn soft_substeps_for_spin(&self, dt: f64) -> usize {
+        const MAX_TURN: f64 = 0.125 * std::f64::consts::PI;
+        const MAX_SOFT_SUBSTEPS: usize = 32;
+        let bodies = self.sets.moving().iter().filter_map(|&i| {
+            let b = self.bodies[i as usize].as_ref()?;
+            Some(self.sets.velocity_in_pass(i, b).1.abs())
+        });
+        let motors = self
+            .joints
+            .iter()
+            .flatten()
+            .filter_map(|j| j.motor.filter(|m| m.enabled))
+            .map(|m| m.target_speed.abs());
+        let fastest = bodies.chain(motors).fold(0.0, f64::max);
+        ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SOFT_SUBSTEPS)
     }
 
     /// The body pairs that the soft step bounced between two moving bodies: pairs that
@@ -133,7 +164,6 @@ impl World {
                 dt,
                 bounce_below: restitution_threshold(self.gravity, dt),
                 friction: true,
-                close_joint_gaps: false,
             },
         );
         for c in self.contacts.iter_mut() {

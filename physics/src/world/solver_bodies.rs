@@ -82,6 +82,7 @@ impl World {
                 local_anchor_b: j.local_anchor_b,
                 motor: j.motor,
                 gap_target: Vec2::zeros(),
+                impulse: Vec2::zeros(),
             };
             if targets == GapTargets::ForBrokenJoints {
                 let gap_now = c.predicted_gap(&inputs.bodies, 0.0);
@@ -103,10 +104,13 @@ impl World {
             b.position = solved.position;
             b.angle = solved.angle;
         }
-        for c in &self.scratch.joint_constraints {
+        let s = &mut self.scratch;
+        s.pin_impulses.resize(self.joints.len(), Vec2::zeros());
+        for c in &s.joint_constraints {
             if let Some(Some(j)) = self.joints.get_mut(c.joint as usize) {
                 j.motor = c.motor;
             }
+            s.pin_impulses[c.joint as usize] += c.impulse;
         }
     }
 }

@@ -486,6 +486,7 @@ mod tests {
                 },
                 motor: None,
                 gap_target: Vec2::zeros(),
+                impulse: Vec2::zeros(),
             })
             .collect();
         (bodies, joints)

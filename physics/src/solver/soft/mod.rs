@@ -68,7 +68,7 @@ mod restitution;
 mod store;
 
 use contact_lcp::ContactLcp;
-use joints::SoftPins;
+use joints::{JointMemory, SoftPins};
 use passes::{integrate_position, integrate_velocity};
 
 /// The SIMD instructions this processor solves the soft step's batches with: "AVX-512"
@@ -426,6 +426,11 @@ pub(crate) struct SoftStepSolver {
     /// Substeps taken since the solver was made: they choose each substep's
     /// `SweepOrder`.
     substeps_taken: u64,
+    /// The warm-start memories and the substep count as they were before this step's
+    /// first try, for a step taken again: a try thrown away must not warm-start the next
+    /// (its impulses, put back on velocities the impact pass has since bounced, add
+    /// energy).
+    before_try: Option<(ContactMemory, JointMemory, u64)>,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
     /// Tests only: every point written, as if no manifold went straight into its lane.
@@ -435,6 +440,23 @@ pub(crate) struct SoftStepSolver {
     pub(crate) stats: StepStats,
     /// The soft step's stages of this world step, handed to the world's profile.
     pub(crate) profile: StepProfile,
+}
+
+impl SoftStepSolver {
+    /// Keeps what the next `step` starts from, for `take_again`.
+    pub(crate) fn keep_for_another_try(&mut self) {
+        let memories = (self.memory.clone(), self.pins.joint_memory.clone());
+        self.before_try = Some((memories.0, memories.1, self.substeps_taken));
+    }
+
+    /// Back to what the step kept by `keep_for_another_try` started from.
+    pub(crate) fn take_again(&mut self) {
+        if let Some((memory, joint_memory, substeps)) = &self.before_try {
+            self.memory.clone_from(memory);
+            self.pins.joint_memory.clone_from(joint_memory);
+            self.substeps_taken = *substeps;
+        }
+    }
 }
 
 /// The direction of a substep's two sweeps (biased, then relaxed) over the colours of the
@@ -804,6 +826,7 @@ mod tests {
             local_anchor_b: Vec2::new(0.5, 0.5),
             motor: None,
             gap_target: Vec2::zeros(),
+            impulse: Vec2::zeros(),
         }];
         let accelerations = vec![(Vec2::new(0.0, 10.0), 0.0); bodies.len()];
         let settings = SoftSettings::for_length_scale(1.0);
