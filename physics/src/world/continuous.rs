@@ -7,6 +7,7 @@ use crate::body::Body;
 use crate::collide::toi::{Sweep, place, separation, time_of_impact, time_of_sinking};
 use crate::collide::{Aabb, WorldPolygon};
 use crate::math::Vec2;
+use crate::solver::ContactSolver;
 use crate::solver::island::UnionFind;
 
 /// Continuous collision's buffers, reused from step to step.
@@ -44,7 +45,8 @@ pub(super) struct Obstacles {
 
 /// Where continuous collision stops a body: the fraction of its step's sweep, and
 /// whether it came from apart (an impact, which the contacts bounce next step) or sank
-/// from contact (the contact solver did not hold it: it moves on only as far as it got).
+/// from contact, or met the obstacle where it started (the contact solver did not hold
+/// it: it moves on only as far as it got).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Stop {
     t: f64,
@@ -147,6 +149,12 @@ impl World {
         let slop = self.settings.slop();
         let margin = self.settings.contact_margin();
         let s = &mut self.scratch.continuous;
+        // Whether the step's pins were solved apart from its contacts (`thesis`,
+        // `sequential`).
+        let pins_apart = matches!(
+            self.settings.contact_solver,
+            ContactSolver::Thesis | ContactSolver::Sequential
+        );
         // The static bodies, looked at when the first body needs them (most steps, none
         // does), and listed again only if the sets changed.
         let mut obstacles = std::mem::take(&mut self.obstacles);
@@ -170,11 +178,10 @@ impl World {
             // jointed bodies too: the walker under `thesis` got 57% less far in 1,000
             // steps, and the car's pins under `exact` opened 2.8e-3 px instead of 2e-5.)
             let fast = 0.5 * body.inner_radius();
+            let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
             // Slow enough for any body, and then for a jointed one: most bodies are
             // the first, and need no search among the jointed.
-            if motion <= fast.min(margin)
-                || motion <= fast && self.jointed.binary_search(&(i as u32)).is_ok()
-            {
+            if motion <= fast.min(margin) || motion <= fast && jointed {
                 continue;
             }
             if !std::mem::replace(&mut listed, true) {
@@ -223,6 +230,10 @@ impl World {
                 // In contact at the start and far deeper at the end: the contact solver
                 // did not hold it (under `thesis`, the joint pass after the contacts drags
                 // a stopped link on into a wall); it goes back to where it was 2 × slop deep.
+                // Where pins and contacts are solved together, a jointed body sinks only
+                // where the repair of a broken pin (positions, before the contacts) moved
+                // it: taken back, the repair would be undone at every step, and its pins
+                // never close; the contacts push it out instead.
                 let hit = time_of_impact(
                     local,
                     radius,
@@ -232,9 +243,14 @@ impl World {
                     0.25 * slop,
                     &mut s.toi_scratch,
                 )
-                .map(|t| Stop { t, sank: false })
+                // Stopped within the slop of where it started, it met the obstacle at
+                // the step's start: the contacts had it, as one that sank.
+                .map(|t| Stop {
+                    t,
+                    sank: t * motion <= slop,
+                })
                 .or_else(|| {
-                    if end_gap >= -2.0 * slop {
+                    if end_gap >= -2.0 * slop || jointed && !pins_apart {
                         return None;
                     }
                     let t = time_of_sinking(

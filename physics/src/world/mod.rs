@@ -208,8 +208,11 @@ pub struct World {
     /// What `auto` keeps from step to step.
     auto: AutoMemory,
     /// The substeps the pins' pull asked for in the last step of the impulse stage list
-    /// (`World::substeps_for_tension`): the next step starts there.
+    /// and of the soft step (`World::substeps_for_tension`): the next step starts there.
     tension_substeps: usize,
+    soft_tension_substeps: usize,
+    /// The soft step's substeps, held (`soft_step::HeldSubsteps`).
+    soft_substeps_held: soft_step::HeldSubsteps,
     /// The world's own counts of `StepStats` (the soft step keeps its own).
     stats: StepStats,
     /// The ticks each stage of the last step took (`World::profile`).

@@ -8,6 +8,34 @@ use crate::solver::contact::restitution_threshold;
 use crate::solver::soft::SoftSettings;
 use crate::solver::system::VelocityTargets;
 
+/// The most substeps a soft step takes for fast turns or the pins' pull.
+const MAX_SOFT_SUBSTEPS: usize = 32;
+
+/// The soft step's substeps, held at the most asked for a second before they may fall.
+/// Each substep warm-starts from the last one's impulses, the first from the last step's
+/// last: a substep of another length starts from impulses made for another, and a chain
+/// whipping a heavy load, whose pull asked for 4 substeps one step and 9 the next, held
+/// its pins worse than at 4 throughout.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct HeldSubsteps {
+    substeps: usize,
+    until_step: u64,
+}
+
+impl HeldSubsteps {
+    const HOLD_STEPS: u64 = 60;
+
+    fn hold(&mut self, asked: usize, step: u64) -> usize {
+        if asked >= self.substeps || step >= self.until_step {
+            if asked >= self.substeps {
+                self.until_step = step + Self::HOLD_STEPS;
+            }
+            self.substeps = asked;
+        }
+        self.substeps
+    }
+}
+
 impl World {
     /// The soft step has its own stage list: forces, contacts found once, then substeps
     /// that integrate and solve together (see `solver::soft`).
@@ -52,11 +80,16 @@ impl World {
         if may_bounce {
             self.solvers.soft.keep_for_another_try();
         }
-        let substeps = self
+        // Fast turns, and the pins' pull as the last step found it (a heavy load on
+        // light links: `World::substeps_for_tension`), ask for more substeps.
+        let asked = self
             .settings
             .soft_substeps
             .max(1)
-            .max(self.soft_substeps_for_spin(dt));
+            .max(self.soft_substeps_for_spin(dt))
+            .max(self.soft_tension_substeps);
+        let substeps = self.soft_substeps_held.hold(asked, self.step_count);
+        self.scratch.pin_impulses.fill(Vec2::zeros());
         let mut unforeseen = Vec::new();
         loop {
             if may_bounce {
@@ -91,6 +124,7 @@ impl World {
             self.gather_solver_bodies_with(GapTargets::None);
         }
         self.scatter_solver_bodies();
+        self.soft_tension_substeps = self.substeps_for_tension(dt).min(MAX_SOFT_SUBSTEPS);
     }
 
     /// The substeps the step's fastest turn asks for: a body turning faster than a
@@ -100,7 +134,6 @@ impl World {
     /// start, up to `MAX_SOFT_SUBSTEPS`.
     fn soft_substeps_for_spin(&self, dt: f64) -> usize {
         const MAX_TURN: f64 = 0.125 * std::f64::consts::PI;
-        const MAX_SOFT_SUBSTEPS: usize = 32;
         let bodies = self.sets.moving().iter().filter_map(|&i| {
             let b = self.bodies[i as usize].as_ref()?;
             Some(self.sets.velocity_in_pass(i, b).1.abs())

@@ -610,7 +610,7 @@ impl SoftStepSolver {
         }
         self.pins.pin_plan.scatter(&mut self.pins.joints);
         let started = stage_clock::mark();
-        self.store(bodies, contacts, joints);
+        self.store(bodies, contacts, joints, settings.substeps);
         self.profile.record(Stage::Storing, started);
         self.report();
     }

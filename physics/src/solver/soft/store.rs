@@ -50,6 +50,7 @@ impl SoftStepSolver {
         bodies: &mut [SolverBody],
         contacts: &mut [Contact],
         joints: &mut [JointConstraint],
+        substeps: usize,
     ) {
         for &i in &self.loaded.moving {
             let (b, s) = (&mut bodies[i as usize], &self.loaded.bodies[i as usize]);
@@ -95,6 +96,9 @@ impl SoftStepSolver {
             self.pins
                 .joint_memory
                 .keep(j.input, (j.slot, j.impulse, j.motor_impulse));
+            // Each substep starts from the impulse the last one ended with: the step's
+            // is about that many times one substep's.
+            joints[j.input as usize].impulse += j.impulse * substeps as f64;
             if let Some(m) = joints[j.input as usize].motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
                 m.step_impulse = j.motor_step_total;
