@@ -93,12 +93,17 @@ impl World {
     /// ω·h < 2, ω² = Σ F·r / I over b's pins: past it, light links holding a heavy load
     /// shake themselves apart from round-off. The
     /// estimate bounds the chain's fastest zigzag from above (by about 2 for a uniform
-    /// link, whose neighbours give way), and a substep is kept at ω·h ≤ 2 by it.
+    /// link, whose neighbours give way), and a substep is kept at ω·h ≤ 2 by it. Only a
+    /// body pulled at two pins or more has such a mode: one pulled at a single pin (a
+    /// pendulum's bob) turns about it with the pendulum, slowly, and counting it would
+    /// vary the substeps along every swing, which drains a swing's energy.
+    ///
+    /// Measured on the bodies where the step ends.
     pub(super) fn substeps_for_tension(&mut self, dt: f64) -> usize {
         const MAX_STIFF_TURN: f64 = 2.0;
         let s = &mut self.scratch;
         s.pull_stiffness.clear();
-        s.pull_stiffness.resize(self.bodies.len(), 0.0);
+        s.pull_stiffness.resize(self.bodies.len(), (0.0, 0));
         let mut any = false;
         for (j, impulse) in self.joints.iter().zip(&s.pin_impulses) {
             let Some(j) = j else { continue };
@@ -117,7 +122,8 @@ impl World {
                 let arm = crate::math::Rot::new(body.angle).apply(local);
                 let pull = (force * sign).dot(&arm);
                 if pull > 0.0 {
-                    s.pull_stiffness[handle.expect("a body").index()] += pull;
+                    let (stiffness, pins) = &mut s.pull_stiffness[handle.expect("a body").index()];
+                    (*stiffness, *pins) = (*stiffness + pull, *pins + 1);
                     any = true;
                 }
             }
@@ -130,7 +136,10 @@ impl World {
             .moving()
             .iter()
             .filter_map(|&i| Some((i, self.bodies[i as usize].as_ref()?)))
-            .map(|(i, b)| s.pull_stiffness[i as usize] * b.inv_inertia)
+            .map(|(i, b)| match s.pull_stiffness[i as usize] {
+                (stiffness, 2..) => stiffness * b.inv_inertia,
+                _ => 0.0,
+            })
             .fold(0.0, f64::max)
             .sqrt();
         ((fastest * dt / MAX_STIFF_TURN).ceil() as usize).clamp(1, MAX_SUBSTEPS)

@@ -279,7 +279,7 @@ struct Scratch {
     /// `JointConstraint::impulse` gathered in each pass), and each body's stiffness from
     /// its pins' pull (`World::substeps_for_tension`).
     pin_impulses: Vec<Vec2>,
-    pull_stiffness: Vec<f64>,
+    pull_stiffness: Vec<(f64, u32)>,
     sleeping: SleepScratch,
     continuous: ContinuousScratch,
     auto: AutoScratch,
