@@ -5,7 +5,7 @@
 use super::{GapTargets, Pipeline, World};
 use crate::math::Vec2;
 use crate::solver::contact::restitution_threshold;
-use crate::solver::soft::SoftSettings;
+use crate::solver::soft::settings::SoftSettings;
 use crate::solver::system::VelocityTargets;
 
 /// The most substeps a soft step takes for fast turns or the pins' pull.

@@ -20,8 +20,8 @@
 //! processor is known to have both: their operations are `#[inline(always)]` wrappers of
 //! intrinsics that become single instructions when inlined there.
 
+use super::bodies::{BodyRow, SoftBody};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
-use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 

@@ -7,8 +7,8 @@
 //! Only a function compiled for AVX-512 may use this type, and only once the processor
 //! is known to have it: its operations are `#[inline(always)]` wrappers of intrinsics.
 
+use super::bodies::{BodyRow, SoftBody};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
-use super::{BodyRow, SoftBody};
 use std::arch::x86_64::*;
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 

@@ -1,8 +1,7 @@
 //! The bodies as the soft step reads them (`SoftBody`, the null body last), loaded at the
 //! step's start, and which of them move, are in motion or are pinned.
 
-use super::SoftBody;
-use crate::math::Vec2;
+use crate::math::{Rot, Vec2};
 use crate::solver::SolverBody;
 use crate::solver::island::merged_increasing;
 use crate::solver::joint::JointConstraint;
@@ -103,5 +102,90 @@ impl LoadedBodies {
         if body.moves() || has_velocity {
             self.in_motion.push(i);
         }
+    }
+}
+
+/// A body during the soft step: velocity, inverse mass, and how far it moved this step.
+///
+/// Laid out for the batches' SIMD paths (`avx2::Avx2Lanes::gather`, `avx512`), which read
+/// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
+/// transpose them into lanes: the two rows start at 0 and 32 bytes. A body is 64-byte
+/// aligned, so that both rows lie in one cache line: at 96 bytes a body every other one
+/// straddles two, which a big pile whose bodies leave the level-2 cache pays for in
+/// every pass (docs/bench/profile.md, "The Zen 1: the big scenes wait on memory").
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C, align(64))]
+pub(super) struct SoftBody {
+    pub(super) v: Vec2,
+    pub(super) w: f64,
+    pub(super) inv_mass: f64,
+    /// Displacement and rotation since the start of the step.
+    pub(super) dp: Vec2,
+    pub(super) dq: Rot,
+    pub(super) inv_inertia: f64,
+    pub(super) dangle: f64,
+}
+
+/// Which four numbers of a body a batch reads together (`SoftBody::row`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum BodyRow {
+    /// `v.x, v.y, w, inv_mass`.
+    Velocity,
+    /// `dp.x, dp.y, dq.cos, dq.sin`.
+    Motion,
+}
+
+// The rows `SoftBody::row_offset` names.
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    assert!(size_of::<Vec2>() == 16 && size_of::<Rot>() == 16);
+    assert!(offset_of!(SoftBody, v) == 0 && offset_of!(SoftBody, w) == 16);
+    assert!(offset_of!(SoftBody, inv_mass) == 24);
+    assert!(offset_of!(SoftBody, dp) == 32 && offset_of!(SoftBody, dq) == 48);
+    assert!(offset_of!(Rot, cos) == 0 && offset_of!(Rot, sin) == 8);
+    assert!(std::mem::align_of::<SoftBody>() == 64 && size_of::<SoftBody>() == 128);
+};
+
+impl SoftBody {
+    /// The four numbers of `row`, in its order.
+    pub(super) fn row(&self, row: BodyRow) -> [f64; 4] {
+        match row {
+            BodyRow::Velocity => [self.v.x, self.v.y, self.w, self.inv_mass],
+            BodyRow::Motion => [self.dp.x, self.dp.y, self.dq.cos, self.dq.sin],
+        }
+    }
+
+    /// Where `row` starts, in f64s from the start of the body (the layout asserted below
+    /// the struct).
+    #[cfg(target_arch = "x86_64")]
+    pub(super) const fn row_offset(row: BodyRow) -> usize {
+        match row {
+            BodyRow::Velocity => 0,
+            BodyRow::Motion => 4,
+        }
+    }
+
+    /// The body a batch's unused lanes point at: fixed and at rest.
+    pub(super) fn null() -> Self {
+        Self {
+            dq: Rot { cos: 1.0, sin: 0.0 },
+            ..Self::default()
+        }
+    }
+
+    /// A body as the step starts it: its velocity and inverse mass, not yet moved.
+    pub(super) fn at_step_start(b: &SolverBody) -> Self {
+        Self {
+            v: b.velocity,
+            w: b.angular_velocity,
+            inv_mass: b.inv_mass,
+            inv_inertia: b.inv_inertia,
+            ..Self::null()
+        }
+    }
+
+    /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
+    pub(super) fn moves(&self) -> bool {
+        self.inv_mass > 0.0 || self.inv_inertia > 0.0
     }
 }

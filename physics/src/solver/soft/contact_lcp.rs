@@ -2,10 +2,11 @@
 //! ratio their friction) solved as one LCP per pass.
 
 use super::batch::PassSettings;
+use super::bodies::SoftBody;
+use super::constraints::PointConstraint;
 use super::contacts::{
     BodyPair, apply_normal, approach, point_target, solve_friction, solve_point,
 };
-use super::{PointConstraint, SoftBody};
 use crate::math::{Vec2, perp};
 use crate::solver::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 

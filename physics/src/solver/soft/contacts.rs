@@ -2,7 +2,8 @@
 //! the same arithmetic the batches run lane by lane.
 
 use super::batch::PassSettings;
-use super::{NormalBlock, PointConstraint, SoftBody};
+use super::bodies::SoftBody;
+use super::constraints::{NormalBlock, PointConstraint};
 use crate::math::{Rot, Vec2, clamp, cross, greater, lesser, perp};
 
 /// Re-applies a point's accumulated impulses at the start of a substep.

@@ -1,10 +1,13 @@
 //! The soft step's pins and motors: each pin's last impulses kept for warm starting, a
 //! small island of pins solved as one linear system, and a pin or motor solved alone.
 
+use super::SoftStepSolver;
 use super::bodies::LoadedBodies;
+use super::bodies::SoftBody;
+use super::constraints::SoftJoint;
 use super::contacts::BodyPair;
 use super::pins::PinPlan;
-use super::{SoftBody, SoftJoint, SoftStepSolver, Softness};
+use super::settings::Softness;
 use crate::math::{Rot, Vec2, clamp, cross_scalar};
 use crate::solver::SolverBody;
 use crate::solver::envelope::EnvelopeCholesky;
@@ -192,9 +195,9 @@ pub(super) struct JointBlock {
     rhs: Vec<f64>,
     /// This step's factor of each island's K, by island (`SoftStepSolver::joint_islands`).
     factors: Vec<IslandFactor>,
-    /// Tests only: K factored in every pass.
-    #[cfg(test)]
-    factor_every_pass: bool,
+    /// A crate-private check, off in use: K factored in every pass, not only where the
+    /// arms changed, so that a test can show the kept factors give the same bits.
+    pub(super) factor_every_pass: bool,
     /// How many times K was factored (`StepStats::soft_pin_factorisations`).
     pub(super) factored: u64,
 }
@@ -323,7 +326,6 @@ impl JointBlock {
         }
         let cached = &self.factors[index];
         let same_arms = cached.arm_bits.iter().copied().eq(arm_bits(&self.arms));
-        #[cfg(test)]
         let same_arms = same_arms && !self.factor_every_pass;
         if !same_arms {
             self.factored += 1;
@@ -454,7 +456,7 @@ pub(super) fn solve_joint(
 
 #[cfg(test)]
 mod tests {
-    use super::super::SoftSettings;
+    use super::super::settings::SoftSettings;
     use super::super::tests::state_bits;
     use super::*;
     use crate::solver::SolverBody;

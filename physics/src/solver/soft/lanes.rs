@@ -6,7 +6,7 @@
 //! scalar code does, so all three give the same bits: where the scalar code fuses a
 //! multiply and an add (`f64::mul_add`, one rounding), the lanes do too (`Lanes::mul_add`).
 
-use super::{BodyRow, SoftBody};
+use super::bodies::{BodyRow, SoftBody};
 use std::ops::{Add, AddAssign, BitAnd, BitXor, Div, Mul, Neg, Sub, SubAssign};
 
 /// How many manifolds a batch holds, one a lane.

@@ -7,19 +7,23 @@
 //! relax without bias. Contacts are found once per step; separations follow the bodies
 //! through the substeps by their anchors.
 //!
-//! This module holds the shared types and the stage list (`SoftStepSolver::step`); each
-//! stage is in the module named for it.
+//! This module holds the solver and its stage list (`SoftStepSolver::step`); each stage
+//! is in the module named for it, and the types the stages share in the module named
+//! for each: the bodies (`bodies`), the contact points and pins (`constraints`),
+//! the tuning (`settings`).
 
 use super::SolverBody;
 use super::contact::{Contact, ContactMemory};
 use super::island::IslandGrouping;
 use super::joint::JointConstraint;
 use super::simultaneous::IslandReport;
-use crate::math::{Rot, Vec2};
+use crate::math::Vec2;
 use crate::stage_clock::{self, Stage, StepProfile};
 use crate::world::stats::StepStats;
-use batch::{LanePath, PassPlan, PassSettings, PlanInput};
+use batch::{LanePath, PassPlan, PlanInput};
 use bodies::LoadedBodies;
+use constraints::PointConstraint;
+use settings::{MAX_HERTZ_PER_SUBSTEP_RATE, SoftSettings, Softness, contact_pass};
 
 /// `$entry`, running `$inline` compiled with FMA where the processor has it (the copy
 /// `$fma`, with the feature enabled) and as built otherwise: `f64::mul_add` is then one
@@ -56,6 +60,7 @@ mod avx2;
 mod avx512;
 mod batch;
 mod bodies;
+mod constraints;
 mod contact_lcp;
 mod contacts;
 mod joints;
@@ -65,6 +70,7 @@ mod pins;
 mod points;
 mod prepare;
 mod restitution;
+pub(crate) mod settings;
 mod store;
 
 use contact_lcp::ContactLcp;
@@ -83,314 +89,6 @@ pub fn lane_path_name() -> &'static str {
         #[cfg(target_arch = "x86_64")]
         LanePath::Avx512 => "AVX-512",
     }
-}
-
-/// Joint islands up to this many pins are solved as one linear system per pass (a dense
-/// Cholesky of 2m × 2m); larger ones pin by pin, in coloured batches (`pins`). One pass of
-/// pin-by-pin Gauss–Seidel cannot hold a light chain under a heavy load: the error
-/// travels one link per pass.
-const DIRECT_JOINT_LIMIT: usize = 64;
-
-/// Tuning of the soft step; defaults after Box2D v3, scaled by the world's length scale.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct SoftSettings {
-    pub substeps: usize,
-    /// Contact stiffness (Hz), capped at a quarter of the substep rate for stability;
-    /// twice as stiff against a fixed body (as Box2D v3), which holds a pile up from
-    /// below: the 625 jammed discs of Box2D's Confined sample crept 138 mm over 8 s at
-    /// one stiffness, 6.7 mm at two.
-    pub contact_hertz: f64,
-    pub contact_damping_ratio: f64,
-    pub joint_hertz: f64,
-    pub joint_damping_ratio: f64,
-    /// The fastest a soft contact pushes overlapping bodies apart (length units / s).
-    pub max_push_speed: f64,
-    /// The deepest a soft contact lets its bodies sink in one substep's biased pass
-    /// (length units): see `sinking_floor`.
-    pub max_soft_depth: f64,
-    /// The fastest a soft pin pulls its anchors together (length units / s).
-    pub joint_push_speed: f64,
-    /// Whether every other pair of substeps sweeps the colours backwards (`SweepOrder`).
-    pub alternating_sweeps: bool,
-}
-
-impl SoftSettings {
-    pub(crate) fn for_length_scale(length_scale: f64) -> Self {
-        Self {
-            substeps: 4,
-            contact_hertz: 30.0,
-            contact_damping_ratio: 10.0,
-            joint_hertz: 60.0,
-            joint_damping_ratio: 2.0,
-            max_push_speed: 3.0 * length_scale,
-            max_soft_depth: 0.1 * length_scale,
-            // Far faster than contacts: a loaded net of pins (100 × 100, hanging from
-            // seven) opened to 16 m with pins capped at 3 length scales per second, and
-            // to 0.49 m (as Box2D v3's, which has no cap) at 100.
-            joint_push_speed: 100.0 * length_scale,
-            alternating_sweeps: true,
-        }
-    }
-}
-
-/// Mass and impulse scaling of a soft constraint (Box2D's b2Softness): a spring–damper of
-/// the given frequency and damping ratio, made implicit over the substep.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct Softness {
-    bias_rate: f64,
-    mass_scale: f64,
-    impulse_scale: f64,
-}
-
-impl Softness {
-    fn new(hertz: f64, zeta: f64, h: f64) -> Self {
-        if hertz == 0.0 {
-            return Self {
-                bias_rate: 0.0,
-                mass_scale: 1.0,
-                impulse_scale: 0.0,
-            };
-        }
-        let omega = std::f64::consts::TAU * hertz;
-        let a1 = 2.0 * zeta + h * omega;
-        let a2 = h * omega * a1;
-        let a3 = 1.0 / (1.0 + a2);
-        Self {
-            bias_rate: omega / a1,
-            mass_scale: a2 * a3,
-            impulse_scale: a3,
-        }
-    }
-}
-
-/// A body during the soft step: velocity, inverse mass, and how far it moved this step.
-///
-/// Laid out for the batches' SIMD paths (`avx2::Avx2Lanes::gather`, `avx512`), which read
-/// each body's `v, w, inv_mass` as one 32-byte row and `dp, dq` as another, and
-/// transpose them into lanes: the two rows start at 0 and 32 bytes. A body is 64-byte
-/// aligned, so that both rows lie in one cache line: at 96 bytes a body every other one
-/// straddles two, which a big pile whose bodies leave the level-2 cache pays for in
-/// every pass (docs/bench/profile.md, "The Zen 1: the big scenes wait on memory").
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[repr(C, align(64))]
-struct SoftBody {
-    v: Vec2,
-    w: f64,
-    inv_mass: f64,
-    /// Displacement and rotation since the start of the step.
-    dp: Vec2,
-    dq: Rot,
-    inv_inertia: f64,
-    dangle: f64,
-}
-
-/// Which four numbers of a body a batch reads together (`SoftBody::row`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum BodyRow {
-    /// `v.x, v.y, w, inv_mass`.
-    Velocity,
-    /// `dp.x, dp.y, dq.cos, dq.sin`.
-    Motion,
-}
-
-// The rows `SoftBody::row_offset` names.
-const _: () = {
-    use std::mem::{offset_of, size_of};
-    assert!(size_of::<Vec2>() == 16 && size_of::<Rot>() == 16);
-    assert!(offset_of!(SoftBody, v) == 0 && offset_of!(SoftBody, w) == 16);
-    assert!(offset_of!(SoftBody, inv_mass) == 24);
-    assert!(offset_of!(SoftBody, dp) == 32 && offset_of!(SoftBody, dq) == 48);
-    assert!(offset_of!(Rot, cos) == 0 && offset_of!(Rot, sin) == 8);
-    assert!(std::mem::align_of::<SoftBody>() == 64 && size_of::<SoftBody>() == 128);
-};
-
-impl SoftBody {
-    /// The four numbers of `row`, in its order.
-    fn row(&self, row: BodyRow) -> [f64; 4] {
-        match row {
-            BodyRow::Velocity => [self.v.x, self.v.y, self.w, self.inv_mass],
-            BodyRow::Motion => [self.dp.x, self.dp.y, self.dq.cos, self.dq.sin],
-        }
-    }
-
-    /// Where `row` starts, in f64s from the start of the body (the layout asserted below
-    /// the struct).
-    #[cfg(target_arch = "x86_64")]
-    const fn row_offset(row: BodyRow) -> usize {
-        match row {
-            BodyRow::Velocity => 0,
-            BodyRow::Motion => 4,
-        }
-    }
-
-    /// The body a batch's unused lanes point at: fixed and at rest.
-    fn null() -> Self {
-        Self {
-            dq: Rot { cos: 1.0, sin: 0.0 },
-            ..Self::default()
-        }
-    }
-
-    /// A body as the step starts it: its velocity and inverse mass, not yet moved.
-    fn at_step_start(b: &SolverBody) -> Self {
-        Self {
-            v: b.velocity,
-            w: b.angular_velocity,
-            inv_mass: b.inv_mass,
-            inv_inertia: b.inv_inertia,
-            ..Self::null()
-        }
-    }
-
-    /// Whether impulses move it (a fixed body, static, asleep or held, has no inverse mass).
-    fn moves(&self) -> bool {
-        self.inv_mass > 0.0 || self.inv_inertia > 0.0
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct PointConstraint {
-    contact: u32,
-    a: u32,
-    b: u32,
-    normal: Vec2,
-    /// The anchors' levers about the normal and the tangent (`r × n`, `r × t` on A and
-    /// on B), fixed for the step like the anchors: a row's velocity and impulse use them
-    /// instead of crossing the arms again at every pass.
-    levers: PointLevers,
-    /// Separation at the start, minus the anchors' part, so that the current separation is
-    /// `n·(Δ(p_a + r_a) − Δ(p_b + r_b)) + base_separation`.
-    base_separation: f64,
-    normal_mass: f64,
-    tangent_mass: f64,
-    friction: f64,
-    restitution: f64,
-    relative_velocity: f64,
-    normal_impulse: f64,
-    tangent_impulse: f64,
-    max_normal_impulse: f64,
-    /// How fast gravity and forces close the gap (along −normal), for the impact speed.
-    closing_acceleration: f64,
-    /// The fastest impact `approach` may record: the approach at the step's start plus
-    /// what the closing acceleration adds over the step. Any faster is speed the step's
-    /// other contacts gave the bodies, which a bounce must not return: a small body
-    /// wedged between a wall and another body gained half its speed again each step,
-    /// bounced off the one and the other in turn.
-    fastest_impact: f64,
-    /// With the next point: their 2 × 2 normal mass matrix, when the two are one
-    /// manifold's and the block is well conditioned (solved together).
-    pair_coupling: Option<NormalBlock>,
-}
-
-/// The 2 × 2 normal mass matrix K of a manifold's two points and its inverse, computed
-/// once per step so that the passes do not divide.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct NormalBlock {
-    k11: f64,
-    k12: f64,
-    k22: f64,
-    inverse: (f64, f64, f64),
-}
-
-impl NormalBlock {
-    /// The block of two points `p`, `q` of one manifold between bodies `a` and `b`, if it
-    /// is well conditioned.
-    fn of(
-        pair: (&SoftBody, &SoftBody),
-        (p, q): (&PointConstraint, &PointConstraint),
-    ) -> Option<Self> {
-        Self::of_levers(pair, (p.levers.normal, q.levers.normal))
-    }
-
-    /// `of` for two points whose normal levers (`PointLevers::normal`) are `l1` and `l2`.
-    #[inline(always)]
-    fn of_levers(
-        (a, b): (&SoftBody, &SoftBody),
-        (l1, l2): ((f64, f64), (f64, f64)),
-    ) -> Option<Self> {
-        // Multiplied out again rather than taken as 1 / normal_mass, and the inverse
-        // from one reciprocal: divisions were the slowest part of building the points.
-        let m = a.inv_mass + b.inv_mass;
-        let inertias = (a.inv_inertia, b.inv_inertia);
-        let k11 = row_coupling(m, inertias, l1, l1);
-        let k12 = row_coupling(m, inertias, l1, l2);
-        let k22 = row_coupling(m, inertias, l2, l2);
-        let det = k11.mul_add(k22, -(k12 * k12));
-        (k11 > 0.0 && k22 > 0.0 && k11 * k11 < MAX_BLOCK_CONDITION * det).then(|| {
-            let inv_det = 1.0 / det;
-            Self {
-                k11,
-                k12,
-                k22,
-                inverse: (k22 * inv_det, -k12 * inv_det, k11 * inv_det),
-            }
-        })
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct PointLevers {
-    normal: (f64, f64),
-    /// `r · n` on A and on B: how far each anchor reaches along the normal. Also the
-    /// tangent row's levers: r × perp(n) = r · n.
-    reach: (f64, f64),
-}
-
-impl PointLevers {
-    /// The levers of contact `c` about its bodies' centroids at the step's start.
-    #[inline(always)]
-    fn of(bodies: &[SolverBody], c: &Contact) -> Self {
-        let (a, b) = (&bodies[c.body_a.index()], &bodies[c.body_b.index()]);
-        let n = c.normal;
-        let (r_a, r_b) = (c.point - a.position, c.point - b.position);
-        // r × n and r · n, each product added with one rounding (see `BodyPair`).
-        let lever = |r: Vec2| r.x.mul_add(n.y, -(r.y * n.x));
-        let reach = |r: Vec2| r.y.mul_add(n.y, r.x * n.x);
-        Self {
-            normal: (lever(r_a), lever(r_b)),
-            reach: (reach(r_a), reach(r_b)),
-        }
-    }
-
-    /// The tangent row's lever arms, r × t with t = perp(n): the reach, r · n.
-    fn tangent(&self) -> (f64, f64) {
-        self.reach
-    }
-}
-
-/// J M⁻¹ Jᵀ of two rows along one direction between the same two bodies: `inv_masses` the
-/// bodies' summed inverse masses, `inertias` their inverse inertias, and each row's levers
-/// (`r × n` on A and on B). With one row twice, the inverse of its effective mass.
-#[inline(always)]
-fn row_coupling(
-    inv_masses: f64,
-    (ia, ib): (f64, f64),
-    (a1, b1): (f64, f64),
-    (a2, b2): (f64, f64),
-) -> f64 {
-    (ib * b1).mul_add(b2, (ia * a1).mul_add(a2, inv_masses))
-}
-
-/// Two points of one manifold are solved as a block only when their 2 × 2 matrix has a
-/// condition number below this (Box2D v2's bound); nearly parallel rows go one by one.
-const MAX_BLOCK_CONDITION: f64 = 1000.0;
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct SoftJoint {
-    a: u32,
-    b: u32,
-    r_a: Vec2,
-    r_b: Vec2,
-    /// Anchor separation at the start of the step (A − B).
-    base_gap: Vec2,
-    impulse: Vec2,
-    motor_impulse: f64,
-    /// The motor's angular impulse summed over this step's substeps.
-    motor_step_total: f64,
-    motor: Option<(f64, f64)>,
-    slot: u32,
-    /// Its index in the step's input joints (the solver reorders them by island).
-    input: u32,
 }
 
 /// Warm-start memory and buffers, kept between steps.
@@ -433,8 +131,8 @@ pub(crate) struct SoftStepSolver {
     before_try: Option<(ContactMemory, JointMemory, u64)>,
     /// How each island was solved in the last step.
     pub reports: Vec<IslandReport>,
-    /// Tests only: every point written, as if no manifold went straight into its lane.
-    #[cfg(test)]
+    /// A crate-private check, off in use: every point written, as if no manifold went
+    /// straight into its lane, so that a test can show the lanes give the same bits.
     pub(crate) write_every_point: bool,
     /// The soft step's part of the world's `StepStats`.
     pub(crate) stats: StepStats,
@@ -484,28 +182,6 @@ impl SweepOrder {
         } else {
             Self::Backwards
         }
-    }
-}
-
-/// The most a body may turn in one substep (radians).
-const MAX_TURN_PER_SUBSTEP: f64 = 0.25 * std::f64::consts::PI;
-
-/// Soft constraints are capped at a quarter of the substep rate for stability.
-const MAX_HERTZ_PER_SUBSTEP_RATE: f64 = 0.25;
-
-/// A contact pass's settings for substeps of `h`.
-fn contact_pass(h: f64, soft: &Softness, settings: &SoftSettings, use_bias: bool) -> PassSettings {
-    PassSettings {
-        inv_h: 1.0 / h,
-        soft: *soft,
-        static_soft: Softness::new(
-            (2.0 * settings.contact_hertz).min(MAX_HERTZ_PER_SUBSTEP_RATE / h),
-            settings.contact_damping_ratio,
-            h,
-        ),
-        max_push: settings.max_push_speed,
-        max_depth: settings.max_soft_depth,
-        use_bias,
     }
 }
 

@@ -3,13 +3,13 @@
 //! then the rest.
 
 use super::batch::{AskedFor, LaneBatch, LanePath, ManifoldBatch, PassItem, PassSettings};
+use super::bodies::SoftBody;
+use super::constraints::PointConstraint;
 use super::contacts::{solve_pair, solve_point, warm_start_point};
 use super::joints::{solve_joint, solve_motor, warm_start_motor, warm_start_pin};
 use super::pins::{PinPass, PinPlan};
-use super::{
-    MAX_TURN_PER_SUBSTEP, PointConstraint, SoftBody, SoftSettings, SoftStepSolver, Softness,
-    SweepOrder, contact_pass,
-};
+use super::settings::{MAX_TURN_PER_SUBSTEP, SoftSettings, Softness, contact_pass};
+use super::{SoftStepSolver, SweepOrder};
 use crate::math::{Rot, Vec2, clamp};
 use std::ops::Range;
 

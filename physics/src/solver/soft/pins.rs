@@ -10,8 +10,10 @@
 //! (docs/bench/profile.md, "Pins in batches").
 
 use super::batch::{BatchLanes, LaneBatch, LanePath, LaneVelocity, PAD};
+use super::bodies::{BodyRow, SoftBody};
+use super::constraints::{DIRECT_JOINT_LIMIT, SoftJoint};
 use super::lanes::{F64x8, LANES, LaneMask, Lanes};
-use super::{BodyRow, DIRECT_JOINT_LIMIT, SoftBody, SoftJoint, Softness};
+use super::settings::Softness;
 #[cfg(target_arch = "x86_64")]
 use super::{avx2::BothHalves, avx512::F64x8Avx512};
 use crate::math::Vec2;

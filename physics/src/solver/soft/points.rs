@@ -2,9 +2,10 @@
 //! impulses recalled, each manifold placed in its lane or written; and the plan made
 //! from the contacts before the points, where it changed last step.
 
+use super::SoftStepSolver;
 use super::batch::PlanInput;
+use super::constraints::{NormalBlock, PointConstraint, PointLevers, row_coupling};
 use super::contact_lcp::LCP_POINT_LIMIT;
-use super::{NormalBlock, PointConstraint, PointLevers, SoftStepSolver, row_coupling};
 use crate::math::Vec2;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
@@ -317,7 +318,6 @@ impl SoftStepSolver {
         let in_lane = self
             .plan
             .fill_manifold(first, &manifold, &self.loaded.bodies);
-        #[cfg(test)]
         let small = small || self.write_every_point;
         if in_lane && !small {
             return true;

@@ -69,7 +69,6 @@ impl SoftStepSolver {
         // made before the points").
         let started = stage_clock::mark();
         let may_plan_first = !reused && !self.plan.kept_last_step();
-        #[cfg(test)]
         let may_plan_first = may_plan_first && !self.write_every_point;
         let planned_first =
             may_plan_first && self.plan_from_contacts(bodies, contacts, grouping.grouped());

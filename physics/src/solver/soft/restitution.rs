@@ -1,8 +1,9 @@
 //! Restitution, once after the substeps: the points that approached faster than the
 //! threshold and pushed bounce, a manifold's two points together.
 
+use super::SoftStepSolver;
+use super::constraints::PointConstraint;
 use super::contacts::{BodyPair, apply_normal, solve_normal_pair};
-use super::{PointConstraint, SoftStepSolver};
 
 impl SoftStepSolver {
     /// Restitution once, after the substeps, for contacts that were approaching faster

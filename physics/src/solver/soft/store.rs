@@ -1,8 +1,10 @@
 //! The step's results written back: the bodies' velocities and motion, each contact's
 //! and pin's impulses (kept for the next step's warm start), and the island reports.
 
+use super::SoftStepSolver;
 use super::batch::PassItem;
-use super::{DIRECT_JOINT_LIMIT, PointConstraint, SoftStepSolver};
+use super::constraints::DIRECT_JOINT_LIMIT;
+use super::constraints::PointConstraint;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
 use crate::solver::joint::JointConstraint;

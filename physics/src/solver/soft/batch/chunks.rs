@@ -34,7 +34,6 @@ impl PassPlan {
         self.chunk_body_starts.clear();
         self.in_chunk.clear();
         let (from_bytes, chunk_bytes) = (CHUNK_FROM_BYTES, CHUNK_BYTES);
-        #[cfg(test)]
         let (from_bytes, chunk_bytes) = self.chunk_limits.unwrap_or((from_bytes, chunk_bytes));
         let inputs = &self.inputs;
         let island_bytes = |&(from, to, _): &(u32, u32, bool)| -> usize {

@@ -1,11 +1,11 @@
 //! Which SIMD path solves the batches (AVX-512, AVX2 or portable), and the dispatch of
 //! a batch's warm start and solve to it.
 
-use super::super::SoftBody;
 #[cfg(target_arch = "x86_64")]
 use super::super::avx2::{BothHalves, LowerHalf};
 #[cfg(target_arch = "x86_64")]
 use super::super::avx512::F64x8Avx512;
+use super::super::bodies::SoftBody;
 use super::super::lanes::{F64x8, Lanes};
 
 /// The lanes a batch is solved with: the widest this processor has.

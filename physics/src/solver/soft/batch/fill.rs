@@ -1,8 +1,9 @@
 //! A batch filled from its manifolds' points, lane by lane (unused lanes on the null
 //! body), and its impulses read back into the points and contacts.
 
+use super::super::bodies::SoftBody;
+use super::super::constraints::{NormalBlock, PointConstraint, PointLevers};
 use super::super::lanes::LANES;
-use super::super::{NormalBlock, PointConstraint, PointLevers, SoftBody};
 use super::{ManifoldBatch, PAD};
 use crate::math::Vec2;
 

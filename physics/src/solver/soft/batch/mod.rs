@@ -25,8 +25,9 @@
 use super::avx2::BothHalves;
 #[cfg(target_arch = "x86_64")]
 use super::avx512::F64x8Avx512;
+use super::bodies::SoftBody;
+use super::constraints::PointConstraint;
 use super::lanes::{F64x8, LANES};
-use super::{PointConstraint, SoftBody};
 use crate::math::Vec2;
 use crate::solver::island::counting_sort;
 
@@ -80,8 +81,8 @@ pub(super) struct PassPlan {
     chunk_of_input: Vec<u32>,
     /// Each coloured island's bytes of batches, 0 if it goes into no chunk.
     island_bytes: Vec<usize>,
-    /// Tests only: other bounds than `CHUNK_FROM_BYTES` and `CHUNK_BYTES`.
-    #[cfg(test)]
+    /// A crate-private check, off in use: other bounds than `CHUNK_FROM_BYTES` and
+    /// `CHUNK_BYTES`, so that a test can show chunking gives the same bits.
     pub chunk_limits: Option<(usize, usize)>,
     /// Batches of two-point and of one-point manifolds.
     pairs: BatchPool<2>,
@@ -611,8 +612,9 @@ pub(super) const PAD: u32 = u32::MAX;
 
 #[cfg(test)]
 pub(super) mod tests {
+    use super::super::constraints::{NormalBlock, PointLevers};
     use super::super::contacts::{solve_pair, solve_point, warm_start_point};
-    use super::super::{NormalBlock, PointLevers, Softness};
+    use super::super::settings::Softness;
     use super::*;
     use crate::math::{Rot, Vec2, cross};
 

@@ -1,7 +1,8 @@
 //! The batches of a plan, kept from step to step and filled colour by colour.
 
+use super::super::bodies::SoftBody;
+use super::super::constraints::PointConstraint;
 use super::super::lanes::LANES;
-use super::super::{PointConstraint, SoftBody};
 use super::{ManifoldBatch, PAD, PassItem};
 
 /// Batches of `N`-point manifolds being filled for one step: the step's are the first

@@ -1,8 +1,9 @@
 //! A batch's warm start and solve, lane by lane: the same arithmetic as one manifold
 //! solved alone (`contacts`), eight manifolds side by side.
 
+use super::super::bodies::{BodyRow, SoftBody};
 use super::super::lanes::{LANES, LaneMask, Lanes};
-use super::super::{BodyRow, SoftBody, Softness};
+use super::super::settings::Softness;
 use super::dispatch::{BatchLanes, LaneBatch};
 use super::{LaneBounce, LanePoints, ManifoldBatch, PAD};
 
