@@ -153,8 +153,8 @@ const ROUND_TOLERANCE: f64 = 1e-10;
 const STALLED_ROUNDS: usize = 3;
 /// A guessed impulse this close to a bound (relative to the largest) counts as at it: a
 /// wrong guess costs only the check that rejects it (then the round pivots), and at rest
-/// the loose test finds the sets where a tight one misses them (the arch's exact step:
-/// 0.35 ms at 1e-9, 0.19 ms at 1e-4; the overlapping pyramid's 0.55 and 0.15 ms).
+/// the loose test finds the sets where a tight one misses them, and a pile at rest is
+/// solved in one factorisation more often (docs/bench/profile.md).
 const GUESS_AT_BOUND: f64 = 1e-4;
 /// Pivots per row that the friction rounds may spend together; once past, the last
 /// round's solution stands. A solve from scratch takes about one pivot per clamped row;

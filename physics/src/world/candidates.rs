@@ -186,6 +186,11 @@ impl World {
         );
         self.jointed.sort_unstable();
         self.jointed.dedup();
+        self.motor_joints.clear();
+        self.motor_joints.extend(
+            (0..self.joints.len() as u32)
+                .filter(|&k| self.joints[k as usize].is_some_and(|j| j.motor.is_some())),
+        );
         let pivot_sharers = self.pairs_sharing_a_pivot();
         self.non_colliding.rebuild(
             self.joints

@@ -147,12 +147,12 @@ impl World {
     /// far a collision within the step may turn either one off its course.
     ///
     /// Each body's reach finds the manifolds whatever way a collision may send it; of
-    /// those, the smash's debris flying off together kept ~35,000 a step that could not
-    /// act, of ~51,000. The allowance is the guard for the turn: a body closing on others
-    /// at speed v along their normals may change velocity by up to 2v (a bounce), and a
-    /// pinned or motor-driven body by anything. Dropped on the relative reach alone, a
-    /// random throw's pentagon bounced off a wall into a triangle it had no points with,
-    /// 0.12 m deep.
+    /// those, debris flying off together keeps most that cannot act. The allowance is the
+    /// guard for the turn: a body closing on others at speed v along their normals may
+    /// change velocity by up to 2v (a bounce), and a pinned or motor-driven body by
+    /// anything. Dropped on the relative reach alone, a body bounced off a wall into one
+    /// it had no points with (docs/bench/profile.md, "Speculative manifolds that cannot
+    /// act").
     fn drop_idle_manifolds(&mut self, margin: f64) {
         let s = &mut self.scratch;
         let motion = &self.bounds.motion;

@@ -174,14 +174,17 @@ impl World {
             // contacts were found before the solve, for the motion they had then). A
             // jointed body only when fast enough to pass through something: its whole
             // mechanism goes back with it (below), and a robot's feet pressed a little deep
-            // into the ground are the contacts' job. (Measured with the margin rule for
-            // jointed bodies too: the walker under `thesis` got 57% less far in 1,000
-            // steps, and the car's pins under `exact` opened 2.8e-3 px instead of 2e-5.)
+            // into the ground are the contacts' job: taken back too, a robot walks less far
+            // and its pins open more (docs/bench/profile.md, "The measurements behind the
+            // code's rules").
             let fast = 0.5 * body.inner_radius();
-            let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
             // Slow enough for any body, and then for a jointed one: most bodies are
             // the first, and need no search among the jointed.
-            if motion <= fast.min(margin) || motion <= fast && jointed {
+            if motion <= fast.min(margin) {
+                continue;
+            }
+            let jointed = self.jointed.binary_search(&(i as u32)).is_ok();
+            if motion <= fast && jointed {
                 continue;
             }
             if !std::mem::replace(&mut listed, true) {

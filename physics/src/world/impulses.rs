@@ -102,6 +102,9 @@ impl World {
     pub(super) fn substeps_for_tension(&mut self, dt: f64) -> usize {
         const MAX_STIFF_TURN: f64 = 2.0;
         let s = &mut self.scratch;
+        if s.pin_impulses.iter().all(|i| *i == Vec2::zeros()) {
+            return 1;
+        }
         s.pull_stiffness.clear();
         s.pull_stiffness.resize(self.bodies.len(), (0.0, 0));
         let mut any = false;

@@ -139,10 +139,10 @@ impl World {
             Some(self.sets.velocity_in_pass(i, b).1.abs())
         });
         let motors = self
-            .joints
+            .motor_joints
             .iter()
-            .flatten()
-            .filter_map(|j| j.motor.filter(|m| m.enabled))
+            .filter_map(|&k| self.joints[k as usize].and_then(|j| j.motor))
+            .filter(|m| m.enabled)
             .map(|m| m.target_speed.abs());
         let fastest = bodies.chain(motors).fold(0.0, f64::max);
         ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SOFT_SUBSTEPS)

@@ -247,7 +247,7 @@ impl SoftStepSolver {
                 let started = stage_clock::mark();
                 // The first substep's passes read the chunk's batches from farther out and
                 // ask for each next one (`BatchesAhead`); the later ones find them in the
-                // level-2 cache, where asking only costs (many_pyramids' solve 7% slower).
+                // level-2 cache, where asking only costs.
                 let ask = substep == 0;
                 self.warm_start_items(items.clone(), ask);
                 self.profile.record(Stage::WarmStart, started);

@@ -10,8 +10,7 @@ pub(crate) struct SoftSettings {
     pub substeps: usize,
     /// Contact stiffness (Hz), capped at a quarter of the substep rate for stability;
     /// twice as stiff against a fixed body (as Box2D v3), which holds a pile up from
-    /// below: the 625 jammed discs of Box2D's Confined sample crept 138 mm over 8 s at
-    /// one stiffness, 6.7 mm at two.
+    /// below: a jammed pile creeps twenty times less (docs/bench/profile.md).
     pub contact_hertz: f64,
     pub contact_damping_ratio: f64,
     pub joint_hertz: f64,

@@ -94,13 +94,22 @@ impl SoftStepSolver {
         }
         self.memory.store_from(contacts, &impulses);
         self.impulses = impulses;
+        // The pins' pull asks for substeps only where an island of pins is solved as one
+        // system (`DIRECT_JOINT_LIMIT`): there the step holds the pins exactly but for the
+        // pull's own stiffness; a big net, solved pin by pin, stretches whatever the
+        // substeps, and only pays for more. Each substep starts from the impulse the last
+        // one ended with: the step's is about that many times one substep's.
+        for &(start, end) in &self.pins.joint_islands {
+            if end - start <= DIRECT_JOINT_LIMIT {
+                for j in &self.pins.joints[start..end] {
+                    joints[j.input as usize].impulse += j.impulse * substeps as f64;
+                }
+            }
+        }
         for j in &self.pins.joints {
             self.pins
                 .joint_memory
                 .keep(j.input, (j.slot, j.impulse, j.motor_impulse));
-            // Each substep starts from the impulse the last one ended with: the step's
-            // is about that many times one substep's.
-            joints[j.input as usize].impulse += j.impulse * substeps as f64;
             if let Some(m) = joints[j.input as usize].motor.as_mut() {
                 m.last_impulse = j.motor_impulse;
                 m.step_impulse = j.motor_step_total;

@@ -7,9 +7,9 @@ use super::{ManifoldBatch, PassPlan, PlanInput};
 /// From how many bytes of batches a step solves its coloured islands in chunks
 /// (`PassPlan::assign_chunks`), and how many bytes of batches a chunk holds at most (an
 /// island with more stays with the rest). A chunk is solved through every substep before
-/// the next, so its batches are read from the level-2 cache (512 KB a core here) in all
-/// but the first pass, where the whole step's would come from the level 3 in every pass:
-/// many_pyramids' warm start a third cheaper, its solve a seventh (docs/bench/profile.md).
+/// the next, so its batches are read from the level-2 cache in all but the first pass,
+/// where the whole step's would come from the level 3 in every pass
+/// (docs/bench/profile.md, "The Zen 1: the big scenes wait on memory").
 const CHUNK_FROM_BYTES: usize = 1024 * 1024;
 const CHUNK_BYTES: usize = 256 * 1024;
 

@@ -43,11 +43,10 @@ impl PassPlan {
     /// pattern repeated across it, so the one-sidedness of a Gauss–Seidel sweep over the
     /// colours adds up over the pile instead of averaging out, and the pile sways. Coloured
     /// in the order of a hash of their bodies (one counting sort on 8 bits of it: buckets
-    /// scattered over the pile, each in the points' order), the colours fall anywhere,
-    /// and the 100-row pyramid's top box sways at most 0.0025 of a width in 500 steps and
-    /// ends 0.0010 off (in the points' order 0.022 and 0.0063; Box2D v3 0.0094 and
-    /// 0.0041): see docs/bench/profile.md. The colours needed, and so the batches, stay
-    /// about as many (2,400 batch passes a step on the 40-row pyramid, against 2,376).
+    /// scattered over the pile, each in the points' order), the colours fall anywhere, the
+    /// one-sidedness averages out, and the pile sways less than Box2D v3's, with about as
+    /// many colours, and so batches (docs/bench/profile.md, "Colouring in a scattered
+    /// order").
     pub(super) fn colour_in_scattered_order(&mut self) {
         const HASH_BITS: u32 = 8;
         let inputs = &self.inputs;

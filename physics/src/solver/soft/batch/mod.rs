@@ -292,8 +292,7 @@ impl PassPlan {
         // order. The order within a colour changes no result; grouping by orientation
         // keeps a pile's supports and its side contacts in batches of their own, so that
         // fewer batches hold a manifold whose two points part (one touching, one not),
-        // which takes the slower path (`solve_normals_together`): on the 40-row pyramid
-        // at rest 332 of 2,400 batch passes a step, against 504 ungrouped.
+        // which takes the slower path (`solve_normals_together`) (docs/bench/profile.md).
         let key = |m: &ColouredManifold| m.key as usize;
         // Colours 0..COLOURS (`colour_of`), two ways, in each of the rest and the chunks.
         let keys = 2 * COLOURS as usize * (chunks as usize + 1);
@@ -320,7 +319,7 @@ impl PassPlan {
             while i < self.coloured.len() && class_at(&self.coloured, i) == class {
                 let ColouredManifold { first, count, .. } = self.coloured[i];
                 // Filling reads the points in colour order, scattered over the step's
-                // points (the smash's ~12 MB): they are asked for ahead.
+                // points (megabytes of them in a big scene): they are asked for ahead.
                 let ahead = self.coloured.get(i + PREFETCH_AHEAD);
                 if let (Some(ahead), Some(points)) = (ahead, points) {
                     prefetch(&points[ahead.first as usize..][..ahead.count as usize]);
