@@ -1,4 +1,4 @@
-//! What the database holds (SPEC §4.3): body definitions, robots made of placed bodies,
+//! What the database holds (thesis §4.3): body definitions, robots made of placed bodies,
 //! joints and motors, and scenes of placed robots and bodies. Plain data: no physics, no
 //! files. Lengths are in the files' units (the thesis's pixels, y down), angles in radians.
 
@@ -35,7 +35,7 @@ pub struct BodyDef {
     pub location: Location,
 }
 
-/// The thesis's motor (`<force>` on a robot body, SPEC §4.4): a torque on that body alone.
+/// The thesis's motor (`<force>` on a robot body, thesis §4.4): a torque on that body alone.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct BodyMotorDef {
     /// Active for steps time0 ≤ t < time1.
@@ -97,7 +97,7 @@ pub struct RobotBody {
 }
 
 /// `<joint bodyA bodyB anchorAx anchorAy>`: the pin is at bodyA's placement plus the
-/// anchor offset, in robot coordinates (SPEC §6.6).
+/// anchor offset, in robot coordinates (thesis §6.6).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct JointDef {
     pub body_a: String,
@@ -165,7 +165,7 @@ pub struct Scene {
     pub location: Location,
 }
 
-/// The step when a scene gives none (SPEC §6.1: the thesis's numbers behave at h ≪ 1).
+/// The step when a scene gives none (thesis §6.1: the thesis's numbers behave at h ≪ 1).
 pub const DEFAULT_TIMESTEP: f64 = 0.05;
 
 impl Scene {

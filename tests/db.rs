@@ -1,4 +1,4 @@
-//! The XML database (issue 5): the SPEC's examples, round trips, a corpus of broken files,
+//! The XML database (issue 5): the thesis's examples, round trips, a corpus of broken files,
 //! atomic and careful saving, referential integrity.
 
 use proptest::prelude::*;
@@ -72,7 +72,7 @@ fn the_spec_examples_parse_to_their_values() {
         ),
         ("h_1", "h_2", 17.0, -1.0)
     );
-    // SPEC §4.3.2: the joint points are the centres of the overlaps.
+    // thesis §4.3.2: the joint points are the centres of the overlaps.
     assert_eq!(
         housenka.joints[0].point(&housenka.bodies[0].placement),
         [-17.0, 0.0]

@@ -1,4 +1,4 @@
-//! Rigid bodies: a convex polygon with density, restitution and state (SPEC §2.2).
+//! Rigid bodies: a convex polygon with density, restitution and state (thesis §2.2).
 
 use crate::limits;
 use crate::math::{Rot, Vec2, cross, cross_scalar};
@@ -319,18 +319,18 @@ impl Body {
         self.to_world(self.local_origin)
     }
 
-    /// Velocity of the material point at `world_point` (SPEC eq. 1).
+    /// Velocity of the material point at `world_point` (thesis eq. 1).
     pub fn velocity_at(&self, world_point: Vec2) -> Vec2 {
         self.velocity + cross_scalar(self.angular_velocity, world_point - self.position)
     }
 
-    /// A force at a world point: also a torque `r ⊗ F` (SPEC §2.2).
+    /// A force at a world point: also a torque `r ⊗ F` (thesis §2.2).
     pub fn apply_force_at(&mut self, force: Vec2, world_point: Vec2) {
         self.force += force;
         self.torque += cross(world_point - self.position, force);
     }
 
-    /// An impulse at a world point changes the velocities at once (SPEC eq. 5–6). A
+    /// An impulse at a world point changes the velocities at once (thesis eq. 5–6). A
     /// static or sleeping body takes none: wake it first (`World::wake_body`).
     pub fn apply_impulse_at(&mut self, impulse: Vec2, world_point: Vec2) {
         if self.is_fixed() {

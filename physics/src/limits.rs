@@ -22,7 +22,7 @@ pub const SPEED: f64 = 1e9;
 /// Body spins and joint motor speeds (radians / s): a body motor's fastest speed per step
 /// ([`ANGULAR`]) at a step of 1e-4 s.
 pub const SPIN: f64 = 1e10;
-/// A motor's speed, radians per step (SPEC §4.4): half a turn. Faster, a step could not
+/// A motor's speed, radians per step (thesis §4.4): half a turn. Faster, a step could not
 /// show the turn (it would look like turning the other way) and no solver could follow it:
 /// a pin driven so fast tears open in one step.
 pub const ANGULAR: f64 = std::f64::consts::PI;

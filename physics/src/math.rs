@@ -1,4 +1,4 @@
-//! 2D vector helpers in the notation of SPEC §0.
+//! 2D vector helpers in the notation of thesis §0.
 
 /// A 2D vector (f64).
 pub type Vec2 = nalgebra::Vector2<f64>;

@@ -1,4 +1,4 @@
-//! Convex polygons: validation, convex hull and mass properties (SPEC §2.2, §3.1).
+//! Convex polygons: validation, convex hull and mass properties (thesis §2.2, §3.1).
 
 use crate::math::{Vec2, cross};
 use thiserror::Error;
@@ -146,7 +146,7 @@ impl ConvexPolygon {
         &self.vertices
     }
 
-    /// Exact polygon formulas of SPEC §2.2, evaluated relative to the first vertex so that
+    /// Exact polygon formulas of thesis §2.2, evaluated relative to the first vertex so that
     /// shapes far from their origin keep their precision.
     pub fn mass_properties(&self) -> MassProperties {
         let origin = self.vertices[0];
@@ -321,7 +321,7 @@ mod tests {
 
     #[test]
     fn spec_rectangle_has_spec_mass_properties() {
-        // SPEC §2.2 check: the 40×20 "obdelnik".
+        // thesis §2.2 check: the 40×20 "obdelnik".
         let p =
             ConvexPolygon::new(&[v(20., -10.), v(20., 10.), v(-20., 10.), v(-20., -10.)]).unwrap();
         let mp = p.mass_properties();

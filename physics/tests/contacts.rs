@@ -22,7 +22,7 @@ fn world(solver: ContactSolver, friction: f64) -> World {
 }
 
 /// A static floor whose top surface is the line y = 0. Its restitution is 1 so that the
-/// pair's (the minimum, SPEC §6.4) is the other body's.
+/// pair's (the minimum, thesis §6.4) is the other body's.
 fn floor(w: &mut World, width: f64) -> BodyHandle {
     let shape = ConvexPolygon::rectangle(width, 1.0).unwrap();
     w.add_body(
@@ -59,7 +59,7 @@ fn rebound_peak(w: &mut World, body: BodyHandle, half: f64) -> (f64, f64) {
 
 #[test]
 fn square_landing_flat_bounces_straight_up() {
-    // SPEC §2.4.5: with e = 1 and two contacts, one-at-a-time impulses set the square
+    // thesis §2.4.5: with e = 1 and two contacts, one-at-a-time impulses set the square
     // spinning; simultaneous impulses keep it level and return it to its drop height.
     let drop = 2.0;
     for solver in ALL {

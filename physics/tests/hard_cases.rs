@@ -687,7 +687,7 @@ fn every_solver_holds_a_box_on_the_floor_at_the_limits() {
 /// one of density 1 does: nothing in a solve depends on the scale of the masses (the exact
 /// solver's checks once had absolute tolerances, and at 1e-20 the box slid at 0.6 px/s,
 /// at 1e-30 it fell through the floor). Under every solver but the naive sequential one
-/// (which rocks a box on its corners, SPEC §2.4.5) it lies still. A density whose mass
+/// (which rocks a box on its corners, thesis §2.4.5) it lies still. A density whose mass
 /// underflows is refused.
 #[test]
 fn a_very_light_body_moves_as_a_heavy_one() {

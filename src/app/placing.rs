@@ -61,7 +61,7 @@ pub fn free_spot(occupied: &[Aabb], item: Aabb, centre: Vec2) -> Vec2 {
 }
 
 /// How deep two convex outlines overlap along their axis of least overlap (separating
-/// axis theorem, SPEC §3.1); 0 or less when they are apart. Either vertex order works.
+/// axis theorem, thesis §3.1); 0 or less when they are apart. Either vertex order works.
 pub fn overlap_depth(a: &[Vec2], b: &[Vec2]) -> f64 {
     let mut depth = f64::INFINITY;
     for poly in [a, b] {

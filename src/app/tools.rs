@@ -265,7 +265,7 @@ pub fn bodies_at(model: &Model, robot: &Robot, p: Vec2) -> Vec<String> {
 }
 
 /// Pins the two topmost bodies of robot `robot_name` that cover `p` (robot coordinates):
-/// the new joint's anchor is `p` relative to bodyA's placement (SPEC §6.6).
+/// the new joint's anchor is `p` relative to bodyA's placement (thesis §6.6).
 pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDef, String> {
     let robot = model
         .robot(robot_name)

@@ -1,5 +1,5 @@
 //! Whether a model makes sense: ranges, shapes, unique names, references, connected
-//! robots (SPEC §4.1), anchors inside bodies. Every problem names file, line, element.
+//! robots (thesis §4.1), anchors inside bodies. Every problem names file, line, element.
 
 use super::problem::Problem;
 use super::{FileKind, clip};
@@ -8,7 +8,7 @@ use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
 
 /// The step range a scene may ask for: beyond it the motor and contact models stop
-/// making sense (SPEC §6.1 recommends 0.01–0.1; we allow a decade either side).
+/// making sense (thesis §6.1 recommends 0.01–0.1; we allow a decade either side).
 pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
 
 /// The largest magnitude each kind of number may have: the engine's own, so that what
@@ -183,7 +183,7 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
         }
         check_body_motors(&b.motors, &what, file, out);
     }
-    // Connectivity by union-find over aliases (SPEC §4.1).
+    // Connectivity by union-find over aliases (thesis §4.1).
     let mut parent: Vec<usize> = (0..robot.bodies.len()).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -239,7 +239,7 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
         }
         let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
         parent[ra] = rb;
-        // The pin should lie in both bodies (SPEC §4.3.2: the centre of their overlap).
+        // The pin should lie in both bodies (thesis §4.3.2: the centre of their overlap).
         let point = j.point(&robot.bodies[a].placement);
         let inside = [a, b]
             .iter()

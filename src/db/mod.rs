@@ -1,4 +1,4 @@
-//! The database: a directory of three XML files (SPEC §4.3) — bodies.xml, robots.xml,
+//! The database: a directory of three XML files (thesis §4.3) — bodies.xml, robots.xml,
 //! scenes.xml — loaded whatever they contain, checked with messages that name file, line
 //! and element, and saved atomically without ever overwriting what changed on disk.
 

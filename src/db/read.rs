@@ -1,4 +1,4 @@
-//! The meaning of the elements (SPEC §4.3): element trees become model records. A record
+//! The meaning of the elements (thesis §4.3): element trees become model records. A record
 //! whose attributes cannot be read is skipped with an error that names it; everything
 //! else in the file still loads. Range and reference checks are `check.rs`'s.
 

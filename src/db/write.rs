@@ -1,5 +1,5 @@
 //! Model records back to the three files' text, in the element and attribute names of
-//! SPEC §4.3; extensions only where a record uses them, unknown attributes kept.
+//! thesis §4.3; extensions only where a record uses them, unknown attributes kept.
 
 use crate::model::{BodyDef, ExtraAttributes, Robot, Scene};
 use quick_xml::escape::escape;

@@ -1,4 +1,4 @@
-//! Collision detection: bounds, the broad phase and the SAT narrow phase (SPEC §3.1).
+//! Collision detection: bounds, the broad phase and the SAT narrow phase (thesis §3.1).
 
 mod broad;
 mod fixed_cells;
@@ -87,7 +87,7 @@ impl WorldPolygon {
         // to wrap the index: the smash computes ~30,000 polygons' normals a step).
         let next = self.vertices.iter().skip(1).chain(self.vertices.first());
         let edges = self.vertices.iter().zip(next).map(|(v, w)| w - v);
-        // (e_y, −e_x)/|e| is outward for the positive vertex order (SPEC §3.1).
+        // (e_y, −e_x)/|e| is outward for the positive vertex order (thesis §3.1).
         self.normals
             .extend(edges.map(|e| Vec2::new(e.y, -e.x) / e.norm()));
     }
@@ -123,7 +123,7 @@ pub struct ContactPoint {
 pub struct Manifold {
     pub body_a: BodyHandle,
     pub body_b: BodyHandle,
-    /// Unit normal pointing from B towards A (SPEC §2.4).
+    /// Unit normal pointing from B towards A (thesis §2.4).
     pub normal: Vec2,
     points: [ContactPoint; 2],
     len: u8,

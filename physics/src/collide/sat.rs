@@ -1,9 +1,9 @@
-//! Separating-axis narrow phase with reference/incident edge clipping (SPEC §3.1).
+//! Separating-axis narrow phase with reference/incident edge clipping (thesis §3.1).
 //!
 //! The axes are the outward edge normals of both polygons, each tested on its outward side
 //! only: those are exactly the edge normals of the Minkowski difference, so the least
 //! overlap found is the true penetration depth, also for deep penetration and containment.
-//! This gives the same depth as SPEC's two-sided test and a reference edge that faces the
+//! This gives the same depth as the thesis's two-sided test and a reference edge that faces the
 //! other body.
 
 use super::{ContactPoint, FeatureId, Manifold, WorldPolygon};

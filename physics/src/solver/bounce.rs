@@ -1,4 +1,4 @@
-//! A bounce adds no kinetic energy. Newton's law of restitution (SPEC eq. 19) asks each
+//! A bounce adds no kinetic energy. Newton's law of restitution (thesis eq. 19) asks each
 //! point to leave at e times its approach; solved for several points at once (a face's
 //! two corners, a rack of balls struck together, an approach read before another impact
 //! changed it) its answer can leave the bodies faster than they came (docs/physics.md,

@@ -132,12 +132,12 @@ pub struct Contact {
     pub body_a: BodyHandle,
     pub body_b: BodyHandle,
     pub point: Vec2,
-    /// Unit normal from B towards A (SPEC §2.4).
+    /// Unit normal from B towards A (thesis §2.4).
     pub normal: Vec2,
     /// Penetration depth (negative inside the contact margin).
     pub depth: f64,
     pub id: FeatureId,
-    /// Combined coefficient of restitution e (SPEC §6.4: the minimum of the two).
+    /// Combined coefficient of restitution e (thesis §6.4: the minimum of the two).
     pub restitution: f64,
     /// Combined friction coefficient μ.
     pub friction: f64,
@@ -160,7 +160,7 @@ impl Contact {
         gap <= 0.0 || -self.normal_velocity * dt > gap
     }
 
-    /// Whether the contact bounces: it meets this step, fast enough (SPEC §6.4).
+    /// Whether the contact bounces: it meets this step, fast enough (thesis §6.4).
     pub(crate) fn bounces(&self, dt: f64, bounce_below: f64) -> bool {
         self.restitution > 0.0
             && self.meets_this_step(dt)
@@ -186,14 +186,14 @@ impl Contact {
         perp(self.normal)
     }
 
-    /// Velocity of A's point relative to B's, `v_AB` (SPEC eq. 2–3).
+    /// Velocity of A's point relative to B's, `v_AB` (thesis eq. 2–3).
     pub(crate) fn relative_velocity(&self, bodies: &[SolverBody]) -> Vec2 {
         let (a, b) = (&bodies[self.body_a.index()], &bodies[self.body_b.index()]);
         a.velocity_at(self.point) - b.velocity_at(self.point)
     }
 
     /// Velocity change along `d_out` at this contact from a unit impulse along `d_in` at
-    /// `other` (+ on A, − on B): one entry of SPEC's `A_il` with signs (§3.2.2).
+    /// `other` (+ on A, − on B): one entry of the thesis's `A_il` with signs (§3.2.2).
     pub(crate) fn coupling(
         &self,
         d_out: Vec2,
@@ -247,12 +247,12 @@ fn geometric_mean(a: f64, b: f64) -> f64 {
 }
 
 /// The speed below which contacts do not bounce: resting bodies would otherwise hop on the
-/// velocity gravity adds in one step (SPEC §6.4).
+/// velocity gravity adds in one step (thesis §6.4).
 pub(crate) fn restitution_threshold(gravity: Vec2, dt: f64) -> f64 {
     2.0 * gravity.norm() * dt
 }
 
-/// SPEC §2.4.5's "separated" impulses: each contact alone, once, in order (eq. 15 and
+/// thesis §2.4.5's "separated" impulses: each contact alone, once, in order (eq. 15 and
 /// Coulomb friction of §2.4.4). Poor with several contacts — kept as the baseline the
 /// simultaneous solvers are measured against.
 pub(crate) fn solve_sequential(

@@ -1,4 +1,4 @@
-//! Pin (revolute) joints (SPEC §2.5, §3.3): the joint and its motor, and a joint as the
+//! Pin (revolute) joints (thesis §2.5, §3.3): the joint and its motor, and a joint as the
 //! solvers take it: its anchors, its predicted gap, the impulses that close it one joint
 //! at a time, and its blocks of K = J M⁻¹ Jᵀ. The passes over all of them are
 //! `joint_block`'s.
@@ -27,7 +27,7 @@ pub struct Joint {
     pub local_anchor_a: Vec2,
     pub local_anchor_b: Vec2,
     /// Whether the two bodies still collide with each other (off by default: jointed robot
-    /// parts overlap around their pins, SPEC §3.1).
+    /// parts overlap around their pins, thesis §3.1).
     pub collide_connected: bool,
     pub motor: Option<JointMotor>,
 }
@@ -98,7 +98,7 @@ impl JointMotor {
     }
 }
 
-/// How hard the joint passes iterate (SPEC §3.3 Rec: Gauss–Seidel with a tolerance and a cap).
+/// How hard the joint passes iterate (thesis §3.3 Rec: Gauss–Seidel with a tolerance and a cap).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct JointIterations {
     /// Stop once every predicted gap is below this (length units).
@@ -115,7 +115,7 @@ pub(crate) struct JointIterations {
     pub broken_gap: f64,
 }
 
-/// The 2×2 matrix K of SPEC eq. 39: the anchors' relative velocity change per unit impulse.
+/// The 2×2 matrix K of thesis eq. 39: the anchors' relative velocity change per unit impulse.
 fn effective_mass_matrix(a: &SolverBody, r_a: Vec2, b: &SolverBody, r_b: Vec2) -> [[f64; 2]; 2] {
     let m = a.inv_mass + b.inv_mass;
     let (ia, ib) = (a.inv_inertia, b.inv_inertia);
@@ -155,7 +155,7 @@ impl JointConstraint {
         (a.apply(self.local_anchor_a), b.apply(self.local_anchor_b))
     }
 
-    /// Removes the anchors' relative velocity (SPEC eq. 40). Returns |d_v| before.
+    /// Removes the anchors' relative velocity (thesis eq. 40). Returns |d_v| before.
     pub(super) fn correct_velocity(&mut self, bodies: &mut [SolverBody]) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let (r_a, r_b) = self.arms((bodies[ia].angle, bodies[ib].angle));
@@ -181,7 +181,7 @@ impl JointConstraint {
             - end(self.body_b as usize, self.local_anchor_b)
     }
 
-    /// One Newton step on the predicted gap (SPEC eq. 34–39). Returns |d| before.
+    /// One Newton step on the predicted gap (thesis eq. 34–39). Returns |d| before.
     pub(super) fn correct_position(&mut self, bodies: &mut [SolverBody], dt: f64) -> f64 {
         let (ia, ib) = (self.body_a as usize, self.body_b as usize);
         let d = self.predicted_gap(bodies, dt) - self.gap_target;
@@ -212,7 +212,7 @@ pub(crate) fn gap_target(gap_now: Vec2, max_closing: f64) -> Vec2 {
 }
 
 /// What the velocity passes aim a joint's predicted gap at: closed for a healthy joint
-/// (the thesis method, SPEC §3.3), held where it is for a broken one, which only the
+/// (the thesis method, thesis §3.3), held where it is for a broken one, which only the
 /// position repair closes.
 pub(crate) fn velocity_gap_target(gap_now: Vec2, broken_gap: f64) -> Vec2 {
     if gap_now.norm() > broken_gap {

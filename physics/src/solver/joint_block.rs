@@ -1,7 +1,7 @@
 //! The impulse stage list's passes over the pins (`sequential`, `thesis`, `exact`): the
 //! joints grouped into islands, each solved by one direct solve per Newton step
 //! (`PinIsland`) or, when large, by Gauss–Seidel sweeps as the thesis iterates
-//! (SPEC §3.3); motors driven as bounded velocity constraints; broken joints repaired by
+//! (thesis §3.3); motors driven as bounded velocity constraints; broken joints repaired by
 //! positions.
 
 use super::island::{IslandGrouping, island_ranges};
@@ -13,10 +13,10 @@ use super::{BodiesAndMoving, SolverBody};
 use crate::math::{Vec2, clamp};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
-/// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (SPEC §3.3).
+/// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (thesis §3.3).
 pub(crate) const DIRECT_JOINT_LIMIT: usize = 256;
 
-/// Start of step: every joint's anchors stop drifting apart (SPEC §3.3 eq. 40), iterated.
+/// Start of step: every joint's anchors stop drifting apart (thesis §3.3 eq. 40), iterated.
 pub(crate) fn correct_velocities(
     joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
@@ -35,7 +35,7 @@ pub(crate) fn correct_velocities(
 }
 
 /// After contacts: impulses that make every joint's anchors meet at the end of the step
-/// (SPEC §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
+/// (thesis §3.3), Gauss–Seidel until all predicted gaps are within tolerance.
 pub(crate) fn correct_positions(
     joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
@@ -247,7 +247,7 @@ impl JointBlockSolver {
             });
     }
 
-    /// Stage 1 (SPEC eq. 40) for every island: the relative anchor velocities vanish.
+    /// Stage 1 (thesis eq. 40) for every island: the relative anchor velocities vanish.
     pub(crate) fn correct_velocities(
         &mut self,
         joints: &mut [JointConstraint],
@@ -264,7 +264,7 @@ impl JointBlockSolver {
         });
     }
 
-    /// Stage 6 (SPEC §3.3): motors, then Newton steps on the predicted gaps until every
+    /// Stage 6 (thesis §3.3): motors, then Newton steps on the predicted gaps until every
     /// joint closes. Motors and joints alternate so that both hold at the end;
     /// `motors_started` says the motors' impulses of this step so far are in place.
     pub(crate) fn correct_positions(

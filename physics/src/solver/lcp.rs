@@ -1,4 +1,4 @@
-//! A boxed linear complementarity problem solver (SPEC §3.2.4, eq. 32):
+//! A boxed linear complementarity problem solver (thesis §3.2.4, eq. 32):
 //! given symmetric PSD `A`, `b` and bounds `lo ≤ 0 ≤ hi`, find `x` and `w = A·x + b` with
 //! `lo ≤ x ≤ hi` and, per index, `x = lo, w ≥ 0` or `x = hi, w ≤ 0` or `lo < x < hi, w = 0`.
 //!

@@ -96,7 +96,7 @@ impl SolverBody {
 /// How contact impulses are found each step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ContactSolver {
-    /// One contact at a time, once (SPEC §2.4.5): the naive baseline.
+    /// One contact at a time, once (thesis §2.4.5): the naive baseline.
     Sequential,
     /// The thesis: push-apart, a normal LCP, then a boxed friction LCP bounded by those
     /// normals (§3.2.4); joints in their own passes.
@@ -171,7 +171,7 @@ pub(crate) enum ImpulseMethod {
 }
 
 impl ImpulseMethod {
-    /// Overlap is pushed out by moving the pair (SPEC §3.1) before the solve: the
+    /// Overlap is pushed out by moving the pair (thesis §3.1) before the solve: the
     /// thesis's and the sequential method's way. The exact method removes it by split
     /// impulses after its solve instead, which keeps the pins' and contacts' impulses
     /// consistent.

@@ -1,4 +1,4 @@
-//! The thesis's body motor (SPEC §4.4): a torque couple on one body that ramps up while the
+//! The thesis's body motor (thesis §4.4): a torque couple on one body that ramps up while the
 //! body turns slower than its target and switches off when it gets there (bang-bang).
 
 /// Why a motor cannot be added.
@@ -14,7 +14,7 @@ pub enum MotorError {
 }
 
 /// A body motor with the XML `<force>` fields. Times count steps; `angular` is radians per
-/// step and its sign gives the direction (SPEC §4.4 Rec).
+/// step and its sign gives the direction (thesis §4.4 Rec).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyMotor {
     pub time0: u64,

@@ -1,5 +1,5 @@
 //! An island of pins solved at once: K ψ = −residual over all its joints, by one direct
-//! solve per Newton step (SPEC §3.3 eq. 34–39 for the whole island), with its buffers kept
+//! solve per Newton step (thesis §3.3 eq. 34–39 for the whole island), with its buffers kept
 //! from island to island and step to step.
 
 use super::SolverBody;
@@ -266,7 +266,7 @@ impl PinIsland {
         worst
     }
 
-    /// Stage 1 (SPEC eq. 40) for the whole island at once: impulses that make every
+    /// Stage 1 (thesis eq. 40) for the whole island at once: impulses that make every
     /// joint's anchors move together. False if the direct solve is impossible.
     pub(super) fn stop_drift(
         &mut self,

@@ -1,4 +1,4 @@
-//! Simultaneous impulses (SPEC §2.4.6, §3.2), island by island: the thesis's two-stage
+//! Simultaneous impulses (thesis §2.4.6, §3.2), island by island: the thesis's two-stage
 //! friction, and the coupled model that solves normals, friction, pins and joint motors in
 //! one boxed LCP whose friction bounds follow the normal impulses.
 
@@ -64,7 +64,7 @@ pub struct IslandReport {
 /// The two-stage thesis pipeline or the coupled one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum FrictionModel {
-    /// SPEC §3.2.4 steps 1–6: normals without friction, then friction bounded by them.
+    /// thesis §3.2.4 steps 1–6: normals without friction, then friction bounded by them.
     TwoStage,
     /// Normals, friction (bounds ±μ·normal, updated with it), pins and motors together.
     Coupled,
@@ -469,7 +469,7 @@ impl SimultaneousSolver {
         }
     }
 
-    /// SPEC §3.2.4: stage one finds frictionless normals, stage two solves normals and
+    /// thesis §3.2.4: stage one finds frictionless normals, stage two solves normals and
     /// friction with friction bounded by ±μ·(stage-one normal).
     fn solve_two_stage(&mut self, bodies: &mut [SolverBody], targets: &VelocityTargets) {
         let frictionless = VelocityTargets {

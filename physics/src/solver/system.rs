@@ -1,7 +1,7 @@
-//! An island's constraints as rows of one linear complementarity problem (SPEC §3.2):
+//! An island's constraints as rows of one linear complementarity problem (thesis §3.2):
 //! contact normals and friction, pin joints (equality rows) and joint motors (boxed rows).
 //!
-//! Each row is a velocity `J·v` along one direction; `A = J M⁻¹ Jᵀ` (SPEC's `A_il` with
+//! Each row is a velocity `J·v` along one direction; `A = J M⁻¹ Jᵀ` (the thesis's `A_il` with
 //! signs, eq. 17/27) couples rows that share a body.
 
 use super::SolverBody;
@@ -254,7 +254,7 @@ mod tests {
     use crate::collide::FeatureId;
 
     /// The assembled A must equal the measured velocity response to unit impulses — the
-    /// check SPEC §3.2.2 says was made for the matrix.
+    /// check thesis §3.2.2 says was made for the matrix.
     #[test]
     fn matrix_matches_the_response_to_unit_impulses() {
         let bodies = vec![

@@ -27,7 +27,7 @@ fn relative_reach_exceeds(
 }
 
 impl World {
-    /// Broad phase, then SAT on each candidate pair (SPEC §3.1), or the pair's last
+    /// Broad phase, then SAT on each candidate pair (thesis §3.1), or the pair's last
     /// manifold where it has barely moved (`collide::reuse`).
     ///
     /// Each body's bounds and contact margin grow by how far it can move this step, so a

@@ -173,7 +173,7 @@ impl World {
         }
     }
 
-    /// How many substeps this step needs: the joint prediction (SPEC §3.3) follows each
+    /// How many substeps this step needs: the joint prediction (thesis §3.3) follows each
     /// jointed body's rotation by ω·h, and past a quarter radian per step that is too far
     /// from linear for the Newton steps to be trusted (a whipping chain tip turns a radian
     /// per 1/60 s). Usually 1.
@@ -248,7 +248,7 @@ impl World {
         self.joint_pass(dt, JointBlockSolver::repair_positions);
     }
 
-    /// Stage 1: joints whose anchors drift apart stop drifting (SPEC eq. 40).
+    /// Stage 1: joints whose anchors drift apart stop drifting (thesis eq. 40).
     pub(super) fn correct_joint_velocities(&mut self, dt: f64) {
         self.joint_pass(dt, JointBlockSolver::correct_velocities);
     }
@@ -275,7 +275,7 @@ impl World {
     }
 
     /// The thesis removes overlap directly: each pair is pushed apart along its normal by
-    /// its depth, shared by inverse mass (SPEC §3.1). Positions only.
+    /// its depth, shared by inverse mass (thesis §3.1). Positions only.
     pub(super) fn push_apart(&mut self, method: ImpulseMethod) {
         if !method.pushes_apart() {
             return;

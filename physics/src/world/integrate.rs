@@ -6,7 +6,7 @@ use crate::body::Body;
 use crate::math::Vec2;
 
 impl World {
-    /// Stage 2: body motors add their torque (SPEC §4.4), to the bodies the step moves
+    /// Stage 2: body motors add their torque (thesis §4.4), to the bodies the step moves
     /// only: a static or sleeping body's forces are not cleared after the step.
     pub(super) fn apply_motor_torques(&mut self, dt: f64) {
         for (handle, motor) in self.body_motors.iter_mut() {
@@ -20,7 +20,7 @@ impl World {
         }
     }
 
-    /// Gravity and accumulated forces change velocities (SPEC §3.4 steps 2–3).
+    /// Gravity and accumulated forces change velocities (thesis §3.4 steps 2–3).
     /// (Every body's velocity is kept in `start_velocities` first, for restitution: the
     /// awake bodies' each time, the others' when the sets change.)
     pub(super) fn integrate_velocities(&mut self, dt: f64) {
@@ -46,7 +46,7 @@ impl World {
         }
     }
 
-    /// Positions follow velocities (SPEC §3.4 step 7).
+    /// Positions follow velocities (thesis §3.4 step 7).
     pub(super) fn integrate_positions(&mut self, dt: f64) {
         let gravity = self.gravity;
         let explicit = self.settings.integrator == Integrator::ExplicitEuler;

@@ -1,4 +1,4 @@
-//! The world and its step: a list of named stages (SPEC §3.4). This module holds the
+//! The world and its step: a list of named stages (thesis §3.4). This module holds the
 //! world's storage and API and the step's outer stages (`advance`); the solver's stage
 //! list runs in between, `impulses` or `soft_step` (both, under `auto`), and each
 //! stage's work is in the module named for it.
@@ -438,7 +438,7 @@ impl World {
             .fold(0.0, f64::max)
     }
 
-    /// Adds a thesis body motor (SPEC §4.4) driving `body`. Returns its index.
+    /// Adds a thesis body motor (thesis §4.4) driving `body`. Returns its index.
     pub fn add_body_motor(
         &mut self,
         body: BodyHandle,
@@ -495,7 +495,7 @@ impl World {
         self.bodies().map(|(_, b)| b.angular_momentum()).sum()
     }
 
-    /// Advances the world by `dt`: SPEC §3.4's stages, in order.
+    /// Advances the world by `dt`: thesis §3.4's stages, in order.
     ///
     /// With `settings.sleeping`, an island (bodies linked by contacts and joints) whose
     /// bodies have all been slower than `sleep_speed` for `SLEEP_AFTER` seconds, with no

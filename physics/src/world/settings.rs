@@ -6,9 +6,9 @@ use crate::solver::joint::JointIterations;
 /// How velocities and positions advance over a step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// Position from the velocity at the start of the step (SPEC §2.1).
+    /// Position from the velocity at the start of the step (thesis §2.1).
     ExplicitEuler,
-    /// Velocity first, then position with the new velocity: the thesis's order (SPEC §2.2).
+    /// Velocity first, then position with the new velocity: the thesis's order (thesis §2.2).
     #[default]
     SemiImplicitEuler,
 }
@@ -62,7 +62,7 @@ impl Default for StepSettings {
 }
 
 impl StepSettings {
-    /// Bodies closer than this count as touching, so resting contacts persist (SPEC §3.1).
+    /// Bodies closer than this count as touching, so resting contacts persist (thesis §3.1).
     pub(crate) fn contact_margin(&self) -> f64 {
         0.02 * self.length_scale
     }

@@ -57,7 +57,7 @@ impl SampleBody {
         self.density == 0.0
     }
 
-    /// The outline's area and centroid about the body's origin (a polygon's, SPEC §2.2).
+    /// The outline's area and centroid about the body's origin (a polygon's, thesis §2.2).
     pub fn area_and_centroid(&self) -> (f64, (f64, f64)) {
         let v = &self.vertices;
         let (mut area, mut cx, mut cy) = (0.0, 0.0, 0.0);
