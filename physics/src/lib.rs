@@ -56,13 +56,12 @@ pub use crate::{
         contact::Contact,
         joint::{Joint, JointHandle, JointMotor},
         motor::{BodyMotor, MotorError},
-        simultaneous::{IslandMethod, IslandReport},
+        report::{IslandMethod, IslandReport, StepStats},
         soft::lane_path_name,
     },
     stage_clock::{Stage, StepProfile, ticks_per_microsecond},
     world::{
         FALL_PER_STEP, JointDef, JointError, StepError, World,
         settings::{Integrator, StepSettings},
-        stats::StepStats,
     },
 };

@@ -3,15 +3,14 @@
 pub(crate) mod bounce;
 pub(crate) mod contact;
 pub(crate) mod envelope;
+pub(crate) mod exact;
+pub(crate) mod impacts;
 pub(crate) mod island;
 pub(crate) mod joint;
-pub(crate) mod joint_block;
 pub(crate) mod lcp;
 pub(crate) mod motor;
-mod pin_island;
-pub(crate) mod simultaneous;
+pub(crate) mod report;
 pub(crate) mod soft;
-pub(crate) mod system;
 
 use crate::body::Body;
 use crate::math::{Vec2, cross, cross_scalar};

@@ -6,7 +6,7 @@ use crate::collide::Manifold;
 use crate::solver::ImpulseMethod;
 use crate::solver::contact::Contact;
 use crate::solver::island::UnionFind;
-use crate::solver::simultaneous::IslandReport;
+use crate::solver::report::IslandReport;
 
 /// Seconds an island that went over the exact solver's pivot budget stays on the soft
 /// step under `auto`.

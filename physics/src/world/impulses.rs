@@ -6,11 +6,11 @@
 use super::{Pipeline, World};
 use crate::math::Vec2;
 use crate::solver::contact::{restitution_threshold, solve_sequential};
+use crate::solver::exact::FrictionModel;
+use crate::solver::exact::joint_block::JointBlockSolver;
+use crate::solver::exact::system::VelocityTargets;
 use crate::solver::joint::JointMotor;
 use crate::solver::joint::{JointConstraint, JointIterations};
-use crate::solver::joint_block::JointBlockSolver;
-use crate::solver::simultaneous::FrictionModel;
-use crate::solver::system::VelocityTargets;
 use crate::solver::{BodiesAndMoving, ImpulseMethod};
 
 /// At most this many substeps per step, where fast turns (`World::substeps_for`) or the
@@ -338,6 +338,7 @@ impl World {
                     &mut s.joint_constraints,
                     self.inputs.bodies_and_moving(self.sets.moving()),
                     &targets,
+                    &mut self.solvers.impacts,
                 );
             }
         }

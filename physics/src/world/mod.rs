@@ -15,7 +15,6 @@ pub(crate) mod settings;
 mod sleeping;
 mod soft_step;
 mod solver_bodies;
-pub(crate) mod stats;
 
 use settings::{Integrator, StepSettings};
 
@@ -26,7 +25,6 @@ use candidates::{CandidateScratch, KeptPairs};
 use continuous::{ContinuousScratch, Obstacles};
 use sleeping::SleepScratch;
 use solver_bodies::{GapTargets, SolverInputs};
-use stats::StepStats;
 
 use crate::body::{Body, BodyDef, BodyError, BodyHandle};
 use crate::collide::reuse::ManifoldCache;
@@ -34,10 +32,12 @@ use crate::collide::{Manifold, PairSet};
 use crate::math::Vec2;
 use crate::solver::StageList;
 use crate::solver::contact::Contact;
+use crate::solver::exact::SimultaneousSolver;
+use crate::solver::exact::joint_block::JointBlockSolver;
+use crate::solver::impacts::ImpactPass;
 use crate::solver::joint::{Joint, JointConstraint, JointHandle, JointMotor};
-use crate::solver::joint_block::JointBlockSolver;
 use crate::solver::motor::{BodyMotor, MotorError};
-use crate::solver::simultaneous::{IslandReport, SimultaneousSolver};
+use crate::solver::report::{IslandReport, StepStats};
 use crate::solver::soft::SoftStepSolver;
 use crate::stage_clock::{self, Stage, StepProfile};
 
@@ -250,8 +250,10 @@ enum Pipeline {
 struct Solvers {
     /// The pins' passes of the impulse stage list (`sequential`, `thesis`, `exact`).
     joints: JointBlockSolver,
-    /// The islands' LCPs of `thesis` and `exact`, and the impact pass of every solver.
+    /// The islands' LCPs of `thesis` and `exact`.
     exact: SimultaneousSolver,
+    /// The impact pass, before `exact`'s islands' LCPs and before the soft step.
+    impacts: ImpactPass,
     soft: SoftStepSolver,
     /// When the soft solver last loaded the static and sleeping bodies.
     soft_seen: EpochSeen,

@@ -50,7 +50,7 @@ impl Default for StepSettings {
             integrator: Integrator::default(),
             contact_solver: ContactSolver::default(),
             length_scale: 1.0,
-            dense_row_limit: crate::solver::simultaneous::DENSE_ROW_LIMIT,
+            dense_row_limit: crate::solver::exact::DENSE_ROW_LIMIT,
             sleeping: false,
             continuous: true,
             soft_substeps: 4,

@@ -5,8 +5,8 @@
 use super::{GapTargets, Pipeline, World};
 use crate::math::Vec2;
 use crate::solver::contact::restitution_threshold;
+use crate::solver::exact::system::VelocityTargets;
 use crate::solver::soft::settings::SoftSettings;
-use crate::solver::system::VelocityTargets;
 
 /// The most substeps a soft step takes for fast turns or the pins' pull.
 const MAX_SOFT_SUBSTEPS: usize = 32;
@@ -188,8 +188,8 @@ impl World {
                 c.normal_velocity = c.normal_velocity.min(2.0 * c.depth / dt);
             }
         }
-        self.solvers.exact.dense_row_limit = self.settings.dense_row_limit;
-        self.solvers.exact.propagate_all_impacts(
+        self.solvers.impacts.dense_row_limit = self.settings.dense_row_limit;
+        self.solvers.impacts.on_every_island(
             &mut self.contacts,
             &s.joint_constraints,
             self.inputs.bodies_and_moving(self.sets.moving()),

@@ -8,7 +8,7 @@ use super::constraints::PointConstraint;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
 use crate::solver::joint::JointConstraint;
-use crate::solver::simultaneous::{IslandMethod, IslandReport};
+use crate::solver::report::{IslandMethod, IslandReport};
 
 impl SoftStepSolver {
     /// Records how each island of contacts and of pins was solved.

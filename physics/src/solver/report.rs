@@ -1,4 +1,44 @@
-//! What a world's steps did, counted (`World::stats`).
+//! What the solvers report of a step: how each island was solved (`IslandReport`), and
+//! what the steps so far did, counted (`StepStats`). Every solver writes them and the
+//! world reads them, so they stand on neutral ground, below both.
+
+/// How an island's constraints were solved.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IslandMethod {
+    /// `exact`/`thesis`: the dense LCP by pivoting (up to `StepSettings::dense_row_limit`
+    /// rows).
+    Pivoting,
+    /// `exact`/`thesis` above the row limit: projected Gauss–Seidel row by row.
+    GaussSeidel,
+    /// `soft`: a small contact island of different masses, one LCP per pass (its normals;
+    /// its friction too where the masses differ 100-fold).
+    SoftLcp,
+    /// `soft`: contacts point by point (two-point manifolds as a 2 × 2 block).
+    SoftPointByPoint,
+    /// `soft`: an island of pins, solved as one linear system per pass.
+    SoftPinBlock,
+    /// `soft`: pins one by one (a lone pin, or an island above the block limit, whose
+    /// pins go colour by colour, eight at a time, each lane as if alone: `soft::pins`).
+    SoftPinByPin,
+}
+
+/// What happened in one island during the last step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IslandReport {
+    pub contacts: usize,
+    pub joints: usize,
+    pub rows: usize,
+    pub method: IslandMethod,
+    /// Pivots made, or Gauss–Seidel sweeps (0 for the soft step's islands).
+    pub pivots: usize,
+    /// Whether the exact solve stopped at its pivot budget (`lcp::LcpStats::over_budget`):
+    /// its last round stands, and under `auto` the island goes to the soft step for a
+    /// while.
+    pub over_budget: bool,
+    /// The LCP's complementarity residual (NaN for Gauss–Seidel row by row, which never
+    /// forms the matrix the residual is measured against).
+    pub residual: f64,
+}
 
 /// Counts of what a world's steps did since it was made: how often each shortcut was taken
 /// and how much work the step lists did, for profiling and for tests that check a

@@ -2,10 +2,10 @@
 //! solve per Newton step (thesis §3.3 eq. 34–39 for the whole island), with its buffers kept
 //! from island to island and step to step.
 
-use super::SolverBody;
-use super::envelope::EnvelopeLu;
-use super::joint::{JointConstraint, JointIterations, coupling_block};
 use crate::math::{Rot, Vec2};
+use crate::solver::SolverBody;
+use crate::solver::envelope::EnvelopeLu;
+use crate::solver::joint::{JointConstraint, JointIterations, coupling_block};
 use nalgebra::{DMatrix, DVector};
 
 /// Where the joints' gaps are observed when K is built: at the bodies' present angles, or

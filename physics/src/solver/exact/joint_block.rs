@@ -4,13 +4,13 @@
 //! (thesis §3.3); motors driven as bounded velocity constraints; broken joints repaired by
 //! positions.
 
-use super::island::{IslandGrouping, island_ranges};
-use super::joint::{JointConstraint, JointIterations, gap_target, own_block, solve_2x2};
-use super::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
 use super::pin_island::{PinIsland, displace_island};
 use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
-use super::{BodiesAndMoving, SolverBody};
 use crate::math::{Vec2, clamp};
+use crate::solver::island::{IslandGrouping, island_ranges};
+use crate::solver::joint::{JointConstraint, JointIterations, gap_target, own_block, solve_2x2};
+use crate::solver::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
+use crate::solver::{BodiesAndMoving, SolverBody};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
 /// Newton step; larger ones by Gauss–Seidel sweeps, as the thesis iterates (thesis §3.3).

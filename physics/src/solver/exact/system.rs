@@ -4,11 +4,11 @@
 //! Each row is a velocity `J·v` along one direction; `A = J M⁻¹ Jᵀ` (the thesis's `A_il` with
 //! signs, eq. 17/27) couples rows that share a body.
 
-use super::SolverBody;
-use super::contact::Contact;
-use super::joint::JointConstraint;
-use super::lcp::FrictionBound;
 use crate::math::{Vec2, cross};
+use crate::solver::SolverBody;
+use crate::solver::contact::Contact;
+use crate::solver::joint::JointConstraint;
+use crate::solver::lcp::FrictionBound;
 
 /// One body's part of a row: the row's velocity is `linear·v + angular·ω` summed over both.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
