@@ -3,7 +3,9 @@
 
 use super::problem::Problem;
 use super::{FileKind, clip};
-use crate::model::{BodyDef, BodyMotorDef, Model, Placement, Robot, Scene, SceneRobot, compose};
+use crate::model::{
+    BodyDef, BodyMotorDef, JointMotorDef, Model, Placement, Robot, Scene, SceneRobot, compose,
+};
 use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
 
@@ -16,8 +18,12 @@ pub const TIMESTEP_RANGE: (f64, f64) = (1e-4, 1.0);
 /// pins where its placement in a scene puts them).
 pub use pe::limits;
 
-/// "`what` {value} is larger than {limit}" when `value` exceeds `limit` in magnitude.
+/// "`what` {value} is beyond ±{limit}" when `value` exceeds `limit` in magnitude or is
+/// not a number at all.
 pub fn beyond(what: &str, value: f64, limit: f64) -> Option<String> {
+    if value.is_nan() {
+        return Some(format!("{what} is not a number"));
+    }
     let limit_text = if limit == std::f64::consts::PI {
         "π (half a turn a step)".to_string()
     } else {
@@ -32,6 +38,66 @@ pub fn beyond_all(numbers: &[(&str, f64, f64)]) -> Vec<String> {
         .iter()
         .filter_map(|&(what, value, limit)| beyond(what, value, limit))
         .collect()
+}
+
+// The number checks of each record, in one place: `check` reports them as problems of
+// the files, and the simulation refuses to build a scene that has any (the editor runs
+// models whatever their problems), so both say the same thing in the same words.
+
+/// Why step `h` (seconds) is not one a scene may take, if it is not.
+pub fn timestep_problem(h: f64) -> Option<String> {
+    (!(TIMESTEP_RANGE.0..=TIMESTEP_RANGE.1).contains(&h)).then(|| {
+        format!(
+            "timestep {} s is outside [{}, {}] s",
+            super::write::number(h),
+            TIMESTEP_RANGE.0,
+            TIMESTEP_RANGE.1
+        )
+    })
+}
+
+/// A scene's physical numbers: friction and gravitation (its step is checked by
+/// [`timestep_problem`], since a run may choose another).
+pub fn scene_number_problems(scene: &Scene) -> Vec<String> {
+    let mut out = Vec::new();
+    if scene.friction < 0.0 {
+        out.push(format!("friction {} is negative", scene.friction));
+    }
+    out.extend(beyond_all(&[
+        ("friction", scene.friction, limits::FRICTION),
+        ("gravitation", scene.gravitation, limits::GRAVITY),
+    ]));
+    out
+}
+
+/// A body motor's (`<force>`) numbers: their ranges and signs.
+pub fn body_motor_problems(m: &BodyMotorDef) -> Vec<String> {
+    let mut out = beyond_all(&[
+        ("angular", m.angular, limits::ANGULAR),
+        ("startTorque", m.start_torque, limits::TORQUE),
+        ("maxTorque", m.max_torque, limits::TORQUE),
+        ("increase", m.increase, limits::INCREASE),
+    ]);
+    if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
+        out.push(
+            "startTorque, maxTorque and increase must be ≥ 0 (the sign of angular gives the direction)"
+                .to_string(),
+        );
+    }
+    out
+}
+
+/// A joint motor's numbers: its speed per step and its torque.
+pub fn joint_motor_problems(m: &JointMotorDef) -> Vec<String> {
+    let mut out = Vec::new();
+    if m.max_torque < 0.0 {
+        out.push(format!("maxTorque {} must be ≥ 0", m.max_torque));
+    }
+    out.extend(beyond_all(&[
+        ("angular", m.angular, limits::ANGULAR),
+        ("maxTorque", m.max_torque, limits::TORQUE),
+    ]));
+    out
 }
 
 /// All problems of `model`, whose files are named by `file`.
@@ -214,13 +280,7 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
         }
         if let Some(m) = &j.motor {
             let motor = format!("<motor> of {what}");
-            if m.max_torque < 0.0 {
-                out.push(Problem::error(file, &motor, "maxTorque must be ≥ 0").at(m.location));
-            }
-            for message in beyond_all(&[
-                ("angular", m.angular, limits::ANGULAR),
-                ("maxTorque", m.max_torque, limits::TORQUE),
-            ]) {
+            for message in joint_motor_problems(m) {
                 out.push(Problem::error(file, &motor, message).at(m.location));
             }
         }
@@ -288,19 +348,8 @@ fn check_body_motors(motors: &[BodyMotorDef], what: &str, file: &str, out: &mut 
                     .at(m.location),
             );
         }
-        for message in beyond_all(&[
-            ("angular", m.angular, limits::ANGULAR),
-            ("startTorque", m.start_torque, limits::TORQUE),
-            ("maxTorque", m.max_torque, limits::TORQUE),
-            ("increase", m.increase, limits::INCREASE),
-        ]) {
+        for message in body_motor_problems(m) {
             out.push(Problem::error(file, &what, message).at(m.location));
-        }
-        if m.max_torque < 0.0 || m.start_torque < 0.0 || m.increase < 0.0 {
-            out.push(
-                Problem::error(file, &what, "startTorque, maxTorque and increase must be ≥ 0 (the sign of angular gives the direction)")
-                    .at(m.location),
-            );
         }
     }
 }
@@ -322,22 +371,9 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
     let what = format!("<scene> \"{}\"", clip(&scene.name));
     let mut error =
         |message: String| out.push(Problem::error(file, &what, message).at(scene.location));
-    if scene.friction < 0.0 {
-        error(format!("friction {} is negative", scene.friction));
-    }
-    for message in beyond_all(&[
-        ("friction", scene.friction, limits::FRICTION),
-        ("gravitation", scene.gravitation, limits::GRAVITY),
-    ]) {
+    let step = scene.timestep.and_then(timestep_problem);
+    for message in scene_number_problems(scene).into_iter().chain(step) {
         error(message);
-    }
-    if let Some(h) = scene.timestep
-        && !(TIMESTEP_RANGE.0..=TIMESTEP_RANGE.1).contains(&h)
-    {
-        error(format!(
-            "timestep {h} s is outside [{}, {}] s",
-            TIMESTEP_RANGE.0, TIMESTEP_RANGE.1
-        ));
     }
     if let Some(solver) = &scene.solver
         && ContactSolver::from_name(solver.trim()).is_none()

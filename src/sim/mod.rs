@@ -3,9 +3,9 @@
 
 pub mod trace;
 
-use crate::db::{self, beyond_all, clip, limits};
-use crate::model::{Model, Placement, Scene, same_name};
-use pe::{BodyDef, BodyHandle, ContactSolver, JointDef, JointHandle, JointMotor, Vec2, World};
+use crate::db::{self, clip};
+use crate::model::{BodyMotorDef, JointDef, Model, Placement, Robot, Scene, SceneRobot, same_name};
+use pe::{BodyDef, BodyHandle, ContactSolver, JointHandle, JointMotor, Vec2, World};
 
 /// Why a scene cannot be simulated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -123,13 +123,8 @@ impl Simulation {
             problem,
         };
         let dt = dt.unwrap_or(scene.timestep());
-        if !(db::TIMESTEP_RANGE.0..=db::TIMESTEP_RANGE.1).contains(&dt) {
-            return Err(invalid(format!(
-                "the step {} s is outside [{}, {}] s",
-                db::write::number(dt),
-                db::TIMESTEP_RANGE.0,
-                db::TIMESTEP_RANGE.1
-            )));
+        if let Some(problem) = db::timestep_problem(dt) {
+            return Err(invalid(problem));
         }
         let solver = match (solver, &scene.solver) {
             (Some(s), _) => s,
@@ -184,29 +179,10 @@ impl Simulation {
 
     fn populate(&mut self, scene: &Scene) -> Result<(), String> {
         // The editor simulates a model whatever its problems, so what `db::check` reports
-        // must not reach the engine either. `pe` refuses gravity and friction only when
-        // stepping, and a motor's numbers in its own units: these are refused here, when
-        // the scene is built, in the XML's words.
-        if !(scene.friction.is_finite() && scene.friction >= 0.0) {
-            return Err(format!(
-                "friction {} is not a finite number ≥ 0",
-                scene.friction
-            ));
-        }
-        if !scene.gravitation.is_finite() {
-            return Err(format!(
-                "gravitation {} is not a finite number",
-                scene.gravitation
-            ));
-        }
-        if let Some(message) = beyond_all(&[
-            ("friction", scene.friction, limits::FRICTION),
-            ("gravitation", scene.gravitation, limits::GRAVITY),
-        ])
-        .into_iter()
-        .next()
-        {
-            return Err(message);
+        // must not reach the engine either: the records' numbers are refused here, when
+        // the scene is built, by the same checks and in the same words.
+        if let Some(problem) = db::scene_number_problems(scene).into_iter().next() {
+            return Err(problem);
         }
         self.world.friction = scene.friction;
         self.world.settings.contact_solver = self.solver;
@@ -215,105 +191,7 @@ impl Simulation {
             let robot = model.robot(&placed.source).ok_or_else(|| {
                 format!("robot #{i}: source \"{}\" is not a robot", placed.source)
             })?;
-            let prefix = format!("{}#{i}", robot.name);
-            let frame = (placed.x, placed.y, placed.orientation);
-            let mut handles = Vec::new();
-            for (k, b) in robot.bodies.iter().enumerate() {
-                let p = &b.placement;
-                let id = format!("{prefix}/{}", p.alias);
-                let placed_by = PlacedBy::RobotBody { robot: i, body: k };
-                let handle =
-                    self.add_body(id.clone(), placed_by, p, compose(frame, placement_frame(p)))?;
-                for m in &b.motors {
-                    let numbers = [
-                        ("angular", m.angular, limits::ANGULAR),
-                        ("startTorque", m.start_torque, limits::TORQUE),
-                        ("maxTorque", m.max_torque, limits::TORQUE),
-                        ("increase", m.increase, limits::INCREASE),
-                    ];
-                    if let Some(message) = beyond_all(&numbers).into_iter().next() {
-                        return Err(format!("{id}: motor {message}"));
-                    }
-                    let motor = pe::BodyMotor::new(
-                        m.time0,
-                        m.time1,
-                        m.angular,
-                        m.start_torque,
-                        m.max_torque,
-                        m.increase,
-                    );
-                    self.world
-                        .add_body_motor(handle, motor)
-                        .map_err(|e| format!("{id}: {e}"))?;
-                    self.body_motor_owners.push(self.bodies.len() - 1);
-                }
-                handles.push((p.alias.trim().to_string(), handle));
-            }
-            // A robot's static bodies are its mount (a pivot, a frame): in a real machine the
-            // moving parts pass in front of it, so it collides with the scene, not with them.
-            for (k, &(_, mount)) in handles.iter().enumerate() {
-                if self.world.body(mount).is_some_and(|b| b.is_static()) {
-                    for (m, &(_, other)) in handles.iter().enumerate() {
-                        if m != k {
-                            self.world.ignore_collisions(mount, other);
-                        }
-                    }
-                }
-            }
-            let find = |alias: &str| {
-                handles
-                    .iter()
-                    .find(|(a, _)| same_name(a, alias))
-                    .map(|(_, h)| *h)
-            };
-            for j in &robot.joints {
-                let id = format!("{prefix}/{}-{}", j.body_a.trim(), j.body_b.trim());
-                let a = robot
-                    .body(&j.body_a)
-                    .ok_or_else(|| format!("{id}: no body \"{}\"", j.body_a))?;
-                let (ha, hb) = match (find(&j.body_a), find(&j.body_b)) {
-                    (Some(ha), Some(hb)) => (ha, hb),
-                    _ => return Err(format!("{id}: bodyA or bodyB is not a body of the robot")),
-                };
-                let point = j.point(&a.placement);
-                let (anchor, _) = compose(frame, (point[0], point[1], 0.0));
-                let mut def = JointDef::new(ha, Some(hb), anchor);
-                def.collide_connected = j.collide;
-                let mut motor_window = None;
-                if let Some(m) = &j.motor {
-                    if let Some(message) = beyond_all(&[
-                        ("angular", m.angular, limits::ANGULAR),
-                        ("maxTorque", m.max_torque, limits::TORQUE),
-                    ])
-                    .into_iter()
-                    .next()
-                    {
-                        return Err(format!("{id}: motor {message}"));
-                    }
-                    let speed = m.angular / self.dt;
-                    if !(m.max_torque.is_finite() && m.max_torque >= 0.0 && speed.is_finite()) {
-                        return Err(format!(
-                            "{id}: the motor needs a finite angular and a finite maxTorque ≥ 0 \
-                             (angular {}, maxTorque {})",
-                            m.angular, m.max_torque
-                        ));
-                    }
-                    def.motor = Some(JointMotor {
-                        enabled: (m.time0..m.time1).contains(&0),
-                        ..JointMotor::new(speed, m.max_torque)
-                    });
-                    motor_window = Some((m.time0, m.time1, m.angular));
-                }
-                let handle = self
-                    .world
-                    .add_joint(def)
-                    .map_err(|e| format!("{id}: {e}"))?;
-                self.joints.push(SimJoint {
-                    id,
-                    handle,
-                    motor_window,
-                });
-            }
+            self.add_robot(i, robot, placed)?;
         }
         for (k, p) in scene.bodies.iter().enumerate() {
             let at = (Vec2::new(p.x, p.y), p.orientation);
@@ -324,6 +202,113 @@ impl Simulation {
         self.world.settings.length_scale = self.world.median_body_radius().unwrap_or(1.0);
         make_unique(self.bodies.iter_mut().map(|b| &mut b.id));
         make_unique(self.joints.iter_mut().map(|j| &mut j.id));
+        Ok(())
+    }
+
+    /// The `i`-th robot of the scene, placed by `placed`: its bodies with their motors, its
+    /// mount's collision rule and its joints.
+    fn add_robot(&mut self, i: usize, robot: &Robot, placed: &SceneRobot) -> Result<(), String> {
+        let prefix = format!("{}#{i}", robot.name);
+        let frame = (placed.x, placed.y, placed.orientation);
+        let mut handles = Vec::new();
+        for (k, b) in robot.bodies.iter().enumerate() {
+            let p = &b.placement;
+            let id = format!("{prefix}/{}", p.alias);
+            let placed_by = PlacedBy::RobotBody { robot: i, body: k };
+            let handle =
+                self.add_body(id.clone(), placed_by, p, compose(frame, placement_frame(p)))?;
+            for m in &b.motors {
+                self.add_body_motor(&id, handle, m)?;
+            }
+            handles.push((p.alias.trim().to_string(), handle));
+        }
+        // A robot's static bodies are its mount (a pivot, a frame): in a real machine the
+        // moving parts pass in front of it, so it collides with the scene, not with them.
+        for (k, &(_, mount)) in handles.iter().enumerate() {
+            if self.world.body(mount).is_some_and(|b| b.is_static()) {
+                for (m, &(_, other)) in handles.iter().enumerate() {
+                    if m != k {
+                        self.world.ignore_collisions(mount, other);
+                    }
+                }
+            }
+        }
+        for j in &robot.joints {
+            let id = format!("{prefix}/{}-{}", j.body_a.trim(), j.body_b.trim());
+            let a = robot
+                .body(&j.body_a)
+                .ok_or_else(|| format!("{id}: no body \"{}\"", j.body_a))?;
+            let find = |alias: &str| {
+                handles
+                    .iter()
+                    .find(|(a, _)| same_name(a, alias))
+                    .map(|(_, h)| *h)
+            };
+            let (Some(ha), Some(hb)) = (find(&j.body_a), find(&j.body_b)) else {
+                return Err(format!("{id}: bodyA or bodyB is not a body of the robot"));
+            };
+            let point = j.point(&a.placement);
+            let (anchor, _) = compose(frame, (point[0], point[1], 0.0));
+            self.add_joint(id, ha, hb, anchor, j)?;
+        }
+        Ok(())
+    }
+
+    fn add_body_motor(
+        &mut self,
+        id: &str,
+        body: BodyHandle,
+        m: &BodyMotorDef,
+    ) -> Result<(), String> {
+        if let Some(problem) = db::body_motor_problems(m).into_iter().next() {
+            return Err(format!("{id}: motor: {problem}"));
+        }
+        let motor = pe::BodyMotor::new(
+            m.time0,
+            m.time1,
+            m.angular,
+            m.start_torque,
+            m.max_torque,
+            m.increase,
+        );
+        self.world
+            .add_body_motor(body, motor)
+            .map_err(|e| format!("{id}: {e}"))?;
+        self.body_motor_owners.push(self.bodies.len() - 1);
+        Ok(())
+    }
+
+    /// The pin of `joint` between bodies `a` and `b` at `anchor` (world), with its motor.
+    fn add_joint(
+        &mut self,
+        id: String,
+        a: BodyHandle,
+        b: BodyHandle,
+        anchor: Vec2,
+        joint: &JointDef,
+    ) -> Result<(), String> {
+        let mut def = pe::JointDef::new(a, Some(b), anchor);
+        def.collide_connected = joint.collide;
+        let mut motor_window = None;
+        if let Some(m) = &joint.motor {
+            if let Some(problem) = db::joint_motor_problems(m).into_iter().next() {
+                return Err(format!("{id}: motor: {problem}"));
+            }
+            def.motor = Some(JointMotor {
+                enabled: (m.time0..m.time1).contains(&0),
+                ..JointMotor::new(m.angular / self.dt, m.max_torque)
+            });
+            motor_window = Some((m.time0, m.time1, m.angular));
+        }
+        let handle = self
+            .world
+            .add_joint(def)
+            .map_err(|e| format!("{id}: {e}"))?;
+        self.joints.push(SimJoint {
+            id,
+            handle,
+            motor_window,
+        });
         Ok(())
     }
 
