@@ -2,9 +2,8 @@
 //!
 //! Each body is listed in the cells its bounds cover, the list is grouped by cell (a
 //! counting sort on a hash of the cell), and only bodies sharing a cell are compared:
-//! linear in the number of bodies for piles, grids and blocks alike. (A sweep and prune
-//! along x, its predecessor, compared every body with every other in the same column: a
-//! million pairs per step for a 100 × 100 grid.) A body covering more than `MAX_CELLS`
+//! linear in the number of bodies for piles, grids and blocks alike (a sweep along one
+//! axis compares every body with every other in the same column). A body covering more than `MAX_CELLS`
 //! cells (a floor, a wall) is compared with every body instead of being listed: cheap
 //! while such bodies are few, as they are in a scene of bodies on terrain. A scene of a
 //! few bodies (a robot) skips the grid and compares every pair. Deterministic: the pairs

@@ -141,8 +141,7 @@ pub(crate) struct LcpSolver {
 /// redundant contacts make `A_CC` singular, and this keeps it positive definite while
 /// changing `w` by 1e-12·|x|. It is in `A` itself, so that the factor and `w` agree: added
 /// to the factor alone, a solve with the last sets disagreed with the pivoting that found
-/// them, and every friction round pivoted again (the overlap-recovery pyramid: 2,900
-/// pivots a step instead of 300).
+/// them, and every friction round pivoted again.
 pub(crate) const REGULARISATION: f64 = 1e-12;
 /// Friction-index rounds before giving up on a fixed point, and the relative change of
 /// the impulses at which they stop.
@@ -158,8 +157,7 @@ const STALLED_ROUNDS: usize = 3;
 const GUESS_AT_BOUND: f64 = 1e-4;
 /// Pivots per row that the friction rounds may spend together; once past, the last
 /// round's solution stands. A solve from scratch takes about one pivot per clamped row;
-/// robots in motion take up to 5.3 per row in a step (the default database's, 1,000
-/// steps each), Box2D's arch 6.2 in its first step.
+/// the budget leaves room for the hardest scenes measured (docs/bench/profile.md).
 const PIVOT_BUDGET_PER_ROW: usize = 8;
 /// Projected Gauss–Seidel sweeps of the fallback, and the change (relative to the largest
 /// impulse) below which it stops early.
@@ -249,8 +247,7 @@ impl LcpSolver {
         let mut method = LcpMethod::Pivoting;
         // A guess gives the first round's sets too; `solve_again` keeps the last ones.
         // Where there is no guess, equality rows (pins) are clamped in every solution: a
-        // chain of pins then costs one factorisation, not a pivot per row (milliseconds a
-        // step for a 40-link chain).
+        // chain of pins then costs one factorisation, not a pivot per row.
         let has_equality_rows =
             (0..n).any(|i| p.lo[i] == f64::NEG_INFINITY && p.hi[i] == f64::INFINITY);
         let guessed = guess.len() == n || (guess.is_empty() && has_equality_rows);
@@ -303,8 +300,8 @@ impl LcpSolver {
                 stats.over_budget = true;
                 break;
             }
-            // A fixed point that does not contract (the arch's alternated between 61 and
-            // 67 clamped rows, round after round) is damped from then on: the bounds
+            // A fixed point that does not contract (the clamped set alternating between
+            // two, round after round) is damped from then on: the bounds
             // follow the mean of the last two rounds' normals.
             damped |= change > 0.5 * last_change;
             last_change = change;

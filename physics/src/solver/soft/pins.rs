@@ -25,9 +25,8 @@ const COLOURS: u32 = 32;
 
 /// Pins coloured together, in the island's order: each tile's colours are solved before
 /// the next tile's, so that a pass goes over the bodies of a few hundred pins a colour at
-/// a time while they are in the cache. Coloured whole, the 100 × 100 net's warm start went
-/// over all its 10,000 bodies (640 kB of rows) once a colour: 1.01M cycles a step against
-/// 0.83M in tiles of 512 (whole step 11.9M against 11.4M; tiles of 2,048 the same).
+/// a time while they are in the cache (coloured whole, a big net's rows outgrow the L2
+/// cache; docs/bench/profile.md, "Pins in batches").
 const TILE: usize = 512;
 
 /// The batches of the step's big pin islands, and the buffers that plan them.

@@ -36,9 +36,8 @@ impl SoftSettings {
             joint_damping_ratio: 2.0,
             max_push_speed: 3.0 * length_scale,
             max_soft_depth: 0.1 * length_scale,
-            // Far faster than contacts: a loaded net of pins (100 × 100, hanging from
-            // seven) opened to 16 m with pins capped at 3 length scales per second, and
-            // to 0.49 m (as Box2D v3's, which has no cap) at 100.
+            // Far faster than contacts: a loaded net of pins capped at the contacts'
+            // push speed opens wide (docs/bench/profile.md).
             joint_push_speed: 100.0 * length_scale,
             alternating_sweeps: true,
         }
