@@ -179,7 +179,20 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
             .to_string();
         format!("cannot write {}: {why}", path.display())
     };
-    let folder = match path.parent() {
+    // Written through a symbolic link to where it points, as the database's saving does;
+    // a device or a FIFO (`/dev/stdout`) is written as it is, not replaced.
+    let target = crate::paths::resolve_links(path).map_err(|e| failed(&e))?;
+    if std::fs::metadata(&target).is_ok_and(|m| !m.is_file() && !m.is_dir()) {
+        let mut device = std::fs::OpenOptions::new()
+            .write(true)
+            .open(&target)
+            .map_err(|e| failed(&e))?;
+        return device
+            .write_all(bytes)
+            .and_then(|()| device.flush())
+            .map_err(|e| failed(&e));
+    }
+    let folder = match target.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
@@ -199,7 +212,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
             .map_err(|e| failed(&e))?;
     }
     file.as_file().sync_all().map_err(|e| failed(&e))?;
-    file.persist(path).map_err(|e| failed(&e.error))?;
+    file.persist(&target).map_err(|e| failed(&e.error))?;
     Ok(())
 }
 

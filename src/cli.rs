@@ -163,33 +163,20 @@ fn standard_output() -> Box<dyn Write> {
     }
 }
 
-/// Whether standard output was closed when the process started (`>&-`). Rust's runtime
-/// then opens /dev/null on descriptor 1, read-write, so that writes vanish without an
-/// error; a shell's `> /dev/null` opens it write-only. That read-write /dev/null is the
-/// sign.
+/// Whether standard output was closed when the process started (`>&-`), as the binary
+/// noted before Rust's runtime put /dev/null in its place (`note_standard_output`).
+static STANDARD_OUTPUT_CLOSED: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Notes, before `main` (the runtime then opens /dev/null on a closed descriptor 1, and
+/// writes vanish there without an error), whether standard output is closed. A /dev/null
+/// opened by the caller (`> /dev/null`, `1<>/dev/null`, Python's `DEVNULL`) is open.
+pub fn note_standard_output(closed: bool) {
+    STANDARD_OUTPUT_CLOSED.store(closed, std::sync::atomic::Ordering::Relaxed);
+}
+
 fn standard_output_was_closed() -> bool {
-    #[cfg(unix)]
-    {
-        // SAFETY: plain queries of descriptor 1 into a zeroed stat buffer.
-        unsafe {
-            let flags = libc::fcntl(1, libc::F_GETFL);
-            let mut stat: libc::stat = std::mem::zeroed();
-            if flags == -1 || libc::fstat(1, &mut stat) != 0 {
-                return true;
-            }
-            let read_write = flags & libc::O_ACCMODE == libc::O_RDWR;
-            let dev_null = std::fs::metadata("/dev/null").is_ok_and(|m| {
-                use std::os::unix::fs::MetadataExt;
-                m.rdev() == stat.st_rdev as u64
-            });
-            let char_device = stat.st_mode & libc::S_IFMT == libc::S_IFCHR;
-            read_write && char_device && dev_null
-        }
-    }
-    #[cfg(not(unix))]
-    {
-        false
-    }
+    STANDARD_OUTPUT_CLOSED.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// clap's message for bad arguments as one line: what is wrong and the arguments it names
@@ -303,12 +290,7 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         };
         return Err(Failure(format!("{first}{more}")));
     }
-    for out in args.out.iter().chain(&args.gif) {
-        refuse_to_overwrite_the_database(out, &args.db)?;
-    }
-    if let Some(gif) = &args.gif {
-        require_folder_of(gif)?;
-    }
+    refuse_unsafe_outputs(args)?;
     let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
         .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
     sim.world.settings.sleeping = args.sleep;
@@ -377,10 +359,19 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         let step = sim.step_count();
         if let Err(reason) = stepped {
             let _ = out.flush();
-            return Err(Failure(format!(
+            let failed = format!(
                 "scene \"{}\": step {step}: {reason}",
                 crate::db::clip(&args.scene)
-            )));
+            );
+            // What was simulated is still worth seeing: the GIF ends at the last good step.
+            let gif_note = match (movie, &args.gif) {
+                (Some((recording, _)), Some(path)) => match write_gif(&recording, path) {
+                    Ok(()) => format!(" ({} shows the steps before)", path.display()),
+                    Err(Failure(why)) => format!(" (and {why})"),
+                },
+                _ => String::new(),
+            };
+            return Err(Failure(failed + &gif_note));
         }
         if (step % args.every == 0 || step == args.steps)
             && let Err(e) = emit(&sim, &mut out)
@@ -399,12 +390,44 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         return written(e).outcome();
     }
     if let (Some((recording, _)), Some(path)) = (movie, &args.gif) {
-        let gif = recording
-            .to_gif(animation::WIDTH, animation::HEIGHT)
-            .map_err(Failure)?;
-        animation::write_atomically(path, &gif).map_err(Failure)?;
+        write_gif(&recording, path)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+fn write_gif(recording: &animation::Recording, path: &Path) -> Result<(), Failure> {
+    let gif = recording
+        .to_gif(animation::WIDTH, animation::HEIGHT)
+        .map_err(Failure)?;
+    animation::write_atomically(path, &gif).map_err(Failure)
+}
+
+/// Refuses, before anything is simulated, outputs that would destroy something or could
+/// not be written at the end: the database's own files (as they are or would be, through
+/// links and hard links), the trace and the GIF in one file, a GIF into a folder.
+fn refuse_unsafe_outputs(args: &RunArgs) -> Result<(), Failure> {
+    let outputs = [("--out", &args.out), ("--gif", &args.gif)];
+    for (flag, path) in outputs.iter().filter_map(|(f, p)| Some((*f, p.as_ref()?))) {
+        refuse_to_overwrite_the_database(flag, path, &args.db)?;
+    }
+    if let (Some(out), Some(gif)) = (&args.out, &args.gif)
+        && crate::paths::same_file(out, gif)
+    {
+        return Err(Failure(format!(
+            "{}: --out and --gif name the same file; choose two",
+            gif.display()
+        )));
+    }
+    if let Some(gif) = &args.gif {
+        require_folder_of(gif)?;
+        if gif.is_dir() {
+            return Err(Failure(format!(
+                "cannot write {}: it is a folder; --gif takes a file name",
+                gif.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// Refuses a file whose folder does not exist, before the run rather than after it.
@@ -421,16 +444,14 @@ fn require_folder_of(file: &Path) -> Result<(), Failure> {
     }
 }
 
-/// Refuses a trace file that is one of the database's own files (or the folder).
-fn refuse_to_overwrite_the_database(out: &Path, db: &Path) -> Result<(), Failure> {
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
+/// Refuses an output (`flag`'s file) that is one of the database's own files, or would
+/// be one (a collection the database does not have yet), or the folder.
+fn refuse_to_overwrite_the_database(flag: &str, out: &Path, db: &Path) -> Result<(), Failure> {
     let files = crate::db::FileKind::ALL.map(|k| db.join(k.file_name()));
+    let same = crate::paths::same_file;
     if same(out, db) || files.iter().any(|f| same(out, f)) {
         return Err(Failure(format!(
-            "{}: --out would overwrite the database being run; choose another file",
+            "{}: {flag} would overwrite the database being run; choose another file",
             out.display()
         )));
     }

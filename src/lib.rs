@@ -12,4 +12,5 @@ pub mod app;
 pub mod cli;
 pub mod db;
 pub mod model;
+pub mod paths;
 pub mod sim;

@@ -200,3 +200,110 @@ fn a_closed_standard_output_is_an_error_not_a_trace_lost_in_silence() {
         ["robosim: standard output is closed: nowhere to write the trace (use --out FILE)"]
     );
 }
+
+/// `robosim run --db DB --scene walker --steps 2` with `extra` arguments.
+fn run_walker(db: &Path, extra: &[&std::ffi::OsStr]) -> std::process::Output {
+    Command::new(ROBOSIM)
+        .args(["run", "--scene", "walker", "--steps", "2", "--db"])
+        .arg(db)
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+#[cfg(unix)]
+#[test]
+fn an_output_that_is_a_database_file_by_another_name_is_refused() {
+    let dir = copy_of_data();
+    let scenes = dir.path().join("scenes.xml");
+    let before = std::fs::read(&scenes).unwrap();
+    let elsewhere = tempfile::tempdir().unwrap();
+
+    // A hard link: another path, the same file.
+    let hard = elsewhere.path().join("trace.jsonl");
+    std::fs::hard_link(&scenes, &hard).unwrap();
+    let output = run_walker(dir.path(), &["--out".as_ref(), hard.as_os_str()]);
+    assert_eq!(output.status.code(), Some(2), "{:?}", lines(&output.stderr));
+    assert_eq!(
+        lines(&output.stderr),
+        [format!(
+            "robosim: {}: --out would overwrite the database being run; choose another file",
+            hard.display()
+        )]
+    );
+    assert_eq!(std::fs::read(&scenes).unwrap(), before);
+
+    // A file the database does not have yet (no robots.xml is an empty collection): the
+    // trace written there would become the database's robots.
+    let db = tempfile::tempdir().unwrap();
+    let hostile = Path::new("tests/hostile/cli_arguments");
+    std::fs::copy(hostile.join("bodies.xml"), db.path().join("bodies.xml")).unwrap();
+    std::fs::write(
+        db.path().join("scenes.xml"),
+        r#"<scenes><scene name="s" gravitation="10"><body alias="b" source="box" x="0" y="0"/></scene></scenes>"#,
+    )
+    .unwrap();
+    let robots = db.path().join("robots.xml");
+    for flag in ["--out", "--gif"] {
+        let output = Command::new(ROBOSIM)
+            .args(["run", "--scene", "s", "--steps", "2", "--db"])
+            .arg(db.path())
+            .arg(flag)
+            .arg(&robots)
+            .output()
+            .unwrap();
+        assert_eq!(output.status.code(), Some(2), "{flag}");
+        assert!(!robots.exists(), "{flag} wrote robots.xml");
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_gif_is_written_through_a_symbolic_link_and_into_a_device() {
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("run.gif");
+    let link = dir.path().join("link.gif");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let output = run_walker(Path::new("data"), &["--gif".as_ref(), link.as_os_str()]);
+    assert!(output.status.success(), "{:?}", lines(&output.stderr));
+    assert!(std::fs::symlink_metadata(&link).unwrap().is_symlink());
+    assert!(std::fs::read(&target).unwrap().starts_with(b"GIF89a"));
+
+    // A link to a device is written through, never replaced by a file.
+    let to_stdout = dir.path().join("stdout.gif");
+    std::os::unix::fs::symlink("/dev/stdout", &to_stdout).unwrap();
+    let output = run_walker(
+        Path::new("data"),
+        &["--gif".as_ref(), to_stdout.as_os_str()],
+    );
+    assert!(output.status.success(), "{:?}", lines(&output.stderr));
+    assert!(output.stdout.starts_with(b"GIF89a"));
+    assert!(std::fs::symlink_metadata(&to_stdout).unwrap().is_symlink());
+}
+
+#[cfg(unix)]
+#[test]
+fn standard_output_on_a_read_write_dev_null_is_open() {
+    // What Python's `subprocess.DEVNULL` and a shell's `1<>/dev/null` give.
+    let null = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open("/dev/null")
+        .unwrap();
+    for args in [
+        vec!["check", "--db", "data"],
+        vec!["run", "--db", "data", "--scene", "walker", "--steps", "3"],
+    ] {
+        let output = Command::new(ROBOSIM)
+            .args(&args)
+            .stdout(null.try_clone().unwrap())
+            .output()
+            .unwrap();
+        assert_eq!(
+            output.status.code(),
+            Some(0),
+            "{args:?}: {:?}",
+            lines(&output.stderr)
+        );
+    }
+}

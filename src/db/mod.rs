@@ -16,6 +16,7 @@ pub use problem::{Problem, Severity, one_line};
 pub use xml::{MAX_DEPTH, clip};
 
 use crate::model::{Model, same_name};
+use crate::paths::resolve_links;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -578,22 +579,6 @@ fn write_all_or_nothing(
         }
     }
     Ok(())
-}
-
-/// The file a path names, through any symbolic links (the path itself if it does not
-/// exist yet).
-fn resolve_links(path: &Path) -> std::io::Result<PathBuf> {
-    match std::fs::canonicalize(path) {
-        Ok(target) => Ok(target),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            // A dangling link is written through to where it points.
-            match std::fs::read_link(path) {
-                Ok(points_to) => Ok(path.parent().unwrap_or(Path::new(".")).join(points_to)),
-                Err(_) => Ok(path.to_path_buf()),
-            }
-        }
-        Err(e) => Err(e),
-    }
 }
 
 /// `bytes` in a synced temporary file beside `target`, with `target`'s permissions.
