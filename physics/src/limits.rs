@@ -15,8 +15,10 @@ pub const DENSITY: f64 = 1e12;
 pub const FRICTION: f64 = 1e6;
 /// Each component of gravity (length units / s²).
 pub const GRAVITY: f64 = 1e9;
-/// Motor torques.
+/// Motor torques, and the torque a body is given by hand.
 pub const TORQUE: f64 = 1e15;
+/// The force a body is given by hand (the magnitude of `Body::force`).
+pub const FORCE: f64 = 1e15;
 /// Body velocities (length units / s).
 pub const SPEED: f64 = 1e9;
 /// Body spins and joint motor speeds (radians / s): a body motor's fastest speed per step

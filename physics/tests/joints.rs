@@ -380,7 +380,7 @@ fn a_joint_motor_reports_the_impulse_of_the_whole_step() {
     }
 }
 
-/// The collision filter follows every change of the joints: `add_joint` and `joint_mut`
+/// The collision filter follows every change of the joints: `add_joint` and `set_collide_connected`
 /// (its `collide_connected`) and `remove_joint`, read at the next step.
 #[test]
 fn pinned_bodies_collide_exactly_when_their_joint_lets_them() {
@@ -405,9 +405,9 @@ fn pinned_bodies_collide_exactly_when_their_joint_lets_them() {
         .add_joint(JointDef::new(a, Some(b), Vec2::new(0.25, 0.0)))
         .unwrap();
     assert_eq!(touching(&mut world), 0, "a pin keeps its bodies apart");
-    world.joint_mut(pin).unwrap().collide_connected = true;
+    world.set_collide_connected(pin, true).unwrap();
     assert_eq!(touching(&mut world), 1, "unless it lets them collide");
-    world.joint_mut(pin).unwrap().collide_connected = false;
+    world.set_collide_connected(pin, false).unwrap();
     assert_eq!(touching(&mut world), 0);
     world.remove_joint(pin);
     assert_eq!(

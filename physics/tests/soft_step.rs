@@ -366,11 +366,10 @@ fn a_motor_switched_off_or_removed_stops_driving_its_joint() {
                 spin > 0.1,
                 "{solver:?}: the motor spun the bar up to {spin} only"
             );
-            let motor = &mut w.joint_mut(pin).unwrap().motor;
             if remove {
-                *motor = None;
+                w.set_joint_motor(pin, None).unwrap();
             } else {
-                motor.as_mut().unwrap().enabled = false;
+                w.joint_motor_mut(pin).unwrap().enabled = false;
             }
             for _ in 0..60 {
                 w.step(H);

@@ -354,12 +354,14 @@ impl Simulation {
             }
         }
         self.world.try_step(self.dt).map_err(|e| match e {
-            pe::StepError::StateBeyond { body, .. } => {
+            pe::StepError::StateBeyond { body, .. } | pe::StepError::BadBody { body, .. } => {
                 let id = self.bodies.iter().find(|b| b.handle.0 == body);
                 let name = id.map_or(format!("body {body}"), |b| format!("\"{}\"", clip(&b.id)));
                 e.to_string().replacen(&format!("body {body}"), &name, 1)
             }
-            pe::StepError::PinTorn { joint, .. } | pe::StepError::MotorTooFast { joint, .. } => {
+            pe::StepError::PinTorn { joint, .. }
+            | pe::StepError::MotorTooFast { joint, .. }
+            | pe::StepError::BadJointMotor { joint, .. } => {
                 let id = self.joints.iter().find(|j| j.handle.0 == joint);
                 let name = id.map_or(format!("joint {joint}"), |j| {
                     format!("joint \"{}\"", clip(&j.id))

@@ -4,6 +4,8 @@
 /// Why a motor cannot be added.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MotorError {
+    #[error("the motor's body does not exist")]
+    MissingBody,
     #[error("motor {0} must be a finite number, got {1}")]
     NonFinite(&'static str, f64),
     #[error("motor {0} must not be negative, got {1}")]

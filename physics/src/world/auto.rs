@@ -434,7 +434,7 @@ mod tests {
                 // The arm's island: two rows for its pin, a third for its motor.
                 20 => world.settings.dense_row_limit = 2,
                 22 | 24 => {
-                    let motor = world.joint_mut(shoulder).unwrap().motor.as_mut().unwrap();
+                    let motor = world.joint_motor_mut(shoulder).unwrap();
                     motor.enabled = step == 24;
                 }
                 _ => {}

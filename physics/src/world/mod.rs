@@ -99,6 +99,8 @@ impl JointDef {
 pub enum JointError {
     #[error("the joint refers to a body that does not exist")]
     MissingBody,
+    #[error("there is no such joint")]
+    MissingJoint,
     #[error("a joint needs two different bodies")]
     SameBody,
     #[error("the joint anchor is not a finite point")]
@@ -118,6 +120,25 @@ pub enum StepError {
     BadGravity(f64, f64),
     #[error("the world's friction must be a number in [0, 1e6], got {0}")]
     BadFriction(f64),
+    /// A setting of `StepSettings` out of its range.
+    #[error("the setting {what} must be {range}, got {value}")]
+    BadSetting {
+        what: &'static str,
+        value: f64,
+        range: &'static str,
+    },
+    /// A body given a number beyond `crate::limits` (or not a number) through
+    /// `World::body_mut`: refused before stepping, the world untouched.
+    #[error("body {body}'s {what} is {value:.3e}, beyond ±{limit:e} (or not a number)")]
+    BadBody {
+        body: u32,
+        what: &'static str,
+        value: f64,
+        limit: f64,
+    },
+    /// A joint motor given numbers it cannot have through `World::joint_motor_mut`.
+    #[error("joint {joint}'s {error}")]
+    BadJointMotor { joint: u32, error: MotorError },
     #[error(
         "gravity carries a body {fall:e} from rest in one step, more than {limit:e} ({FALL_PER_STEP} length scales): bodies would fall through each other; take a smaller step"
     )]
@@ -201,6 +222,9 @@ pub struct World {
     /// Pairs kept apart by [`World::ignore_collisions`], besides the jointed ones.
     ignored_pairs: Vec<(u32, u32)>,
     body_motors: Vec<(BodyHandle, BodyMotor)>,
+    /// Some body was handed out by `body_mut` since the last step: every body's numbers
+    /// are checked before the next one.
+    bodies_handed_out: bool,
     manifolds: Vec<Manifold>,
     /// Each pipeline's manifolds kept for reuse (see `Pipeline`).
     manifold_caches: [ManifoldCache; 2],
@@ -304,10 +328,21 @@ impl World {
         Ok(BodyHandle((self.bodies.len() - 1) as u32))
     }
 
-    /// Removes a body; its handle then finds nothing. Returns the body if it existed.
+    /// Removes a body and the joints attached to it (a pin to nothing holds nothing);
+    /// its handle, and theirs, then find nothing, and its body motors act on nothing.
+    /// Returns the body if it existed.
     pub fn remove_body(&mut self, handle: BodyHandle) -> Option<Body> {
         let body = self.bodies.get_mut(handle.index())?.take()?;
         self.sets.mark_changed();
+        for joint in &mut self.joints {
+            if joint
+                .as_ref()
+                .is_some_and(|j| j.body_a == handle || j.body_b == Some(handle))
+            {
+                *joint = None;
+                self.collision_filter_stale = true;
+            }
+        }
         Some(body)
     }
 
@@ -321,6 +356,8 @@ impl World {
         if body.is_static() || body.is_asleep() {
             self.sets.mark_changed();
         }
+        // Whatever it is given is checked before the next step.
+        self.bodies_handed_out = true;
         Some(body)
     }
 
@@ -391,16 +428,38 @@ impl World {
         self.joints.get(handle.index())?.as_ref()
     }
 
-    /// A joint to change; its bodies and `collide_connected` are read again at the next
-    /// step.
-    pub fn joint_mut(&mut self, handle: JointHandle) -> Option<&mut Joint> {
+    /// Whether a joint's two bodies collide with each other; `None` if there is no such
+    /// joint. A joint's bodies and anchors are fixed when it is made (`add_joint` checks
+    /// them): to join other bodies, remove it and add another.
+    pub fn set_collide_connected(&mut self, handle: JointHandle, collide: bool) -> Option<()> {
         let joint = self.joints.get_mut(handle.index())?.as_mut()?;
+        joint.collide_connected = collide;
         self.collision_filter_stale = true;
-        Some(joint)
+        Some(())
     }
 
-    /// A joint's motor to change (switching it on and off, say) without the joint's
-    /// collision filter being rebuilt, as `joint_mut` has it.
+    /// Gives a joint a motor, another one, or none (`None`); refused if there is no such
+    /// joint or the motor's numbers are ones it may not have.
+    pub fn set_joint_motor(
+        &mut self,
+        handle: JointHandle,
+        motor: Option<JointMotor>,
+    ) -> Result<(), JointError> {
+        if let Some(m) = &motor {
+            m.validate().map_err(JointError::BadMotor)?;
+        }
+        let joint = self
+            .joints
+            .get_mut(handle.index())
+            .and_then(Option::as_mut)
+            .ok_or(JointError::MissingJoint)?;
+        joint.motor = motor;
+        self.collision_filter_stale = true; // the list of motor joints
+        Ok(())
+    }
+
+    /// A joint's motor to change (switching it on and off, say); its numbers are checked
+    /// before the next step (`StepError::BadJointMotor`).
     pub fn joint_motor_mut(&mut self, handle: JointHandle) -> Option<&mut JointMotor> {
         self.joints
             .get_mut(handle.index())?
@@ -446,6 +505,9 @@ impl World {
         body: BodyHandle,
         motor: BodyMotor,
     ) -> Result<usize, MotorError> {
+        if self.body(body).is_none() {
+            return Err(MotorError::MissingBody);
+        }
         motor.validate()?;
         self.body_motors.push((body, motor));
         Ok(self.body_motors.len() - 1)
@@ -567,12 +629,17 @@ impl World {
         if !(0.0..=crate::limits::FRICTION).contains(&self.friction) {
             return Err(StepError::BadFriction(self.friction));
         }
+        self.settings.check()?;
         let fall = self.gravity.norm() * dt * dt;
         let limit = FALL_PER_STEP * self.settings.length_scale;
         if fall > limit {
             return Err(StepError::FallsTooFar { fall, limit });
         }
         self.check_motor_speeds(dt)?;
+        if self.bodies_handed_out {
+            self.check_bodies_given()?;
+            self.bodies_handed_out = false;
+        }
         let has_joints = self.joints.iter().any(Option::is_some);
         if has_joints {
             let poses = &mut self.scratch.poses_before;
@@ -593,12 +660,20 @@ impl World {
         self.check_state()
     }
 
-    /// Every enabled joint motor asks for at most half a turn a step.
+    /// Every joint motor's numbers are ones it may have, and every enabled one asks for
+    /// at most half a turn a step.
     fn check_motor_speeds(&self, dt: f64) -> Result<(), StepError> {
         for (k, joint) in self.joints.iter().enumerate() {
-            let Some(m) = joint.and_then(|j| j.motor).filter(|m| m.enabled) else {
+            let Some(m) = joint.and_then(|j| j.motor) else {
                 continue;
             };
+            m.validate().map_err(|error| StepError::BadJointMotor {
+                joint: k as u32,
+                error,
+            })?;
+            if !m.enabled {
+                continue;
+            }
             let turn = m.target_speed * dt;
             if turn.abs() > crate::limits::ANGULAR {
                 return Err(StepError::MotorTooFast {
@@ -657,6 +732,41 @@ impl World {
                 return Err(StepError::PinTorn {
                     joint: k as u32,
                     gap,
+                    limit,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Every body's numbers, as `body_mut` may have set them, within `crate::limits`: what
+    /// `Body::new` checks of a new body, and the forces.
+    fn check_bodies_given(&self) -> Result<(), StepError> {
+        use crate::limits::{ANGLE, COORDINATE, FORCE, FRICTION, SPEED, SPIN, TORQUE};
+        for (handle, b) in self.bodies() {
+            let numbers = [
+                ("x", b.position.x, COORDINATE),
+                ("y", b.position.y, COORDINATE),
+                ("angle", b.angle, ANGLE),
+                ("speed", b.velocity.norm(), SPEED),
+                ("spin", b.angular_velocity, SPIN),
+                ("force", b.force.norm(), FORCE),
+                ("torque", b.torque, TORQUE),
+                ("friction", b.friction.unwrap_or(0.0), FRICTION),
+            ];
+            let beyond = crate::limits::first_beyond(numbers).or_else(|| {
+                let bad_restitution = !(0.0..=1.0).contains(&b.restitution);
+                bad_restitution.then_some(("restitution", b.restitution, 1.0))
+            });
+            let negative_friction = b.friction.is_some_and(|mu| mu < 0.0);
+            let beyond = beyond.or_else(|| {
+                negative_friction.then_some(("friction", b.friction.unwrap_or(0.0), FRICTION))
+            });
+            if let Some((what, value, limit)) = beyond {
+                return Err(StepError::BadBody {
+                    body: handle.0,
+                    what,
+                    value,
                     limit,
                 });
             }

@@ -61,7 +61,31 @@ impl Default for StepSettings {
     }
 }
 
+/// The most substeps a step may be asked for through `StepSettings::soft_substeps`.
+pub const MAX_SOFT_SUBSTEPS: usize = 1024;
+
 impl StepSettings {
+    /// The settings a step can be taken with: a length scale that is a positive length
+    /// within `limits::COORDINATE`, and 1 to `MAX_SOFT_SUBSTEPS` soft substeps.
+    pub(crate) fn check(&self) -> Result<(), super::StepError> {
+        let scale = self.length_scale;
+        if !(scale > 0.0 && scale <= crate::limits::COORDINATE) {
+            return Err(super::StepError::BadSetting {
+                what: "length_scale",
+                value: scale,
+                range: "a length > 0 and at most 1e9",
+            });
+        }
+        if !(1..=MAX_SOFT_SUBSTEPS).contains(&self.soft_substeps) {
+            return Err(super::StepError::BadSetting {
+                what: "soft_substeps",
+                value: self.soft_substeps as f64,
+                range: "1 to 1024",
+            });
+        }
+        Ok(())
+    }
+
     /// Bodies closer than this count as touching, so resting contacts persist (thesis §3.1).
     pub(crate) fn contact_margin(&self) -> f64 {
         0.02 * self.length_scale
