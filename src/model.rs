@@ -133,6 +133,16 @@ impl Robot {
             .iter()
             .find(|b| same_name(&b.placement.alias, alias))
     }
+
+    /// Each alias (trimmed, see `same_name`) and the index of the first body that has it:
+    /// for looking up every joint's bodies in time linear in the robot, not quadratic.
+    pub fn alias_index(&self) -> std::collections::HashMap<&str, usize> {
+        let mut index = std::collections::HashMap::with_capacity(self.bodies.len());
+        for (i, b) in self.bodies.iter().enumerate() {
+            index.entry(b.placement.alias.trim()).or_insert(i);
+        }
+        index
+    }
 }
 
 /// A robot placed in a scene: `<robot source x y orientation>`.

@@ -323,15 +323,28 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
         .collect();
     if roots.len() > 1 {
         let first = root(&mut parent, 0);
-        let loose: Vec<&str> = (0..robot.bodies.len())
+        let loose: Vec<usize> = (0..robot.bodies.len())
             .filter(|&i| root(&mut parent, i) != first)
-            .map(|i| robot.bodies[i].placement.alias.as_str())
             .collect();
+        // A few names, and how many more: the line stays a line for 30,000 loose bodies.
+        const NAMED: usize = 5;
+        let mut named: Vec<String> = loose
+            .iter()
+            .take(NAMED)
+            .map(|&i| format!("\"{}\"", clip(&robot.bodies[i].placement.alias)))
+            .collect();
+        if loose.len() > NAMED {
+            named.push(format!("and {} more", loose.len() - NAMED));
+        }
+        let loose = named.join(", ");
         out.push(
             Problem::error(
                 file,
                 &format!("<robot> \"{name}\""),
-                format!("not all bodies are connected through joints: {loose:?} are not joined to \"{}\"", robot.bodies[0].placement.alias),
+                format!(
+                    "not all bodies are connected through joints: {loose} are not joined to \"{}\"",
+                    clip(&robot.bodies[0].placement.alias)
+                ),
             )
             .at(robot.location),
         );
@@ -518,8 +531,9 @@ fn placed_robot_beyond(robot: &Robot, placed: &SceneRobot) -> Vec<String> {
             ));
         }
     }
+    let aliases = robot.alias_index();
     for j in &robot.joints {
-        let Some(a) = robot.body(&j.body_a) else {
+        let Some(a) = aliases.get(j.body_a.trim()).map(|&i| &robot.bodies[i]) else {
             continue;
         };
         let [px, py] = j.point(&a.placement);

@@ -4,7 +4,7 @@
 pub mod trace;
 
 use crate::db::{self, clip};
-use crate::model::{BodyMotorDef, JointDef, Model, Placement, Robot, Scene, SceneRobot, same_name};
+use crate::model::{BodyMotorDef, JointDef, Model, Placement, Robot, Scene, SceneRobot};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointHandle, JointMotor, Vec2, World};
 
 /// Why a scene cannot be simulated.
@@ -85,12 +85,19 @@ pub struct Simulation {
 /// bodies), so that no two columns of a trace share a name.
 fn make_unique<'a>(ids: impl Iterator<Item = &'a mut String>) {
     let mut taken = std::collections::HashSet::new();
+    // The next suffix to try for each repeated id: n copies of one id take time linear
+    // in n, not quadratic.
+    let mut next_suffix: std::collections::HashMap<String, u64> = Default::default();
     for id in ids {
         if !taken.insert(id.clone()) {
-            let unique = (2..)
-                .map(|k| format!("{id}~{k}"))
-                .find(|candidate| !taken.contains(candidate))
-                .expect("some suffix is free");
+            let k = next_suffix.entry(id.clone()).or_insert(2);
+            let unique = loop {
+                let candidate = format!("{id}~{k}");
+                *k += 1;
+                if !taken.contains(&candidate) {
+                    break candidate;
+                }
+            };
             taken.insert(unique.clone());
             *id = unique;
         }
@@ -220,34 +227,28 @@ impl Simulation {
             for m in &b.motors {
                 self.add_body_motor(&id, handle, m)?;
             }
-            handles.push((p.alias.trim().to_string(), handle));
+            handles.push(handle);
         }
         // A robot's static bodies are its mount (a pivot, a frame): in a real machine the
         // moving parts pass in front of it, so it collides with the scene, not with them.
-        for (k, &(_, mount)) in handles.iter().enumerate() {
+        for (k, &mount) in handles.iter().enumerate() {
             if self.world.body(mount).is_some_and(|b| b.is_static()) {
-                for (m, &(_, other)) in handles.iter().enumerate() {
+                for (m, &other) in handles.iter().enumerate() {
                     if m != k {
                         self.world.ignore_collisions(mount, other);
                     }
                 }
             }
         }
+        let aliases = robot.alias_index();
         for j in &robot.joints {
             let id = format!("{prefix}/{}-{}", j.body_a.trim(), j.body_b.trim());
-            let a = robot
-                .body(&j.body_a)
-                .ok_or_else(|| format!("{id}: no body \"{}\"", j.body_a))?;
-            let find = |alias: &str| {
-                handles
-                    .iter()
-                    .find(|(a, _)| same_name(a, alias))
-                    .map(|(_, h)| *h)
-            };
-            let (Some(ha), Some(hb)) = (find(&j.body_a), find(&j.body_b)) else {
+            let find = |alias: &str| aliases.get(alias.trim()).copied();
+            let (Some(a), Some(b)) = (find(&j.body_a), find(&j.body_b)) else {
                 return Err(format!("{id}: bodyA or bodyB is not a body of the robot"));
             };
-            let point = j.point(&a.placement);
+            let (ha, hb) = (handles[a], handles[b]);
+            let point = j.point(&robot.bodies[a].placement);
             let (anchor, _) = compose(frame, (point[0], point[1], 0.0));
             self.add_joint(id, ha, hb, anchor, j)?;
         }
