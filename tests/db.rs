@@ -524,6 +524,29 @@ fn generated_monsters_give_errors_not_panics() {
         "the message clips the value: {} characters",
         p.message.len()
     );
+    // A million unknown elements (4 MiB) in one body, and a million stray texts: a
+    // million warnings took 130 times the file in memory. The first hundred of each are
+    // listed, the rest counted.
+    let many = format!(
+        "<bodies><body name=\"b\" density=\"1\" cor=\"0\">{}</body><body name=\"t\" density=\"1\" cor=\"0\">{}</body></bodies>",
+        "<x/>".repeat(1 << 20),
+        "<vertex x=\"0\" y=\"0\">t</vertex>".repeat(1 << 18),
+    );
+    let (_, problems, _dir) = load(&[(FileKind::Bodies, many.as_bytes())]);
+    let warnings = problems.iter().filter(|p| !p.is_error()).count();
+    assert!(warnings <= 2 * 101, "{warnings} warnings listed");
+    let counted: Vec<&str> = problems
+        .iter()
+        .filter(|p| p.message.contains("more warnings not listed"))
+        .map(|p| p.message.as_str())
+        .collect();
+    assert_eq!(
+        counted,
+        [
+            "262044 more warnings not listed (the first 100 are)",
+            "1048476 more warnings not listed (the first 100 are)"
+        ]
+    );
     // Deep nesting.
     let deep = format!("{}{}", "<a>".repeat(100_000), "</a>".repeat(100_000));
     let (_, problems, _dir) = load(&[(FileKind::Robots, deep.as_bytes())]);

@@ -2,7 +2,7 @@
 //! whose attributes cannot be read is skipped with an error that names it; everything
 //! else in the file still loads. Range and reference checks are `check.rs`'s.
 
-use super::problem::Problem;
+use super::problem::{FileProblems, Problem};
 use super::xml::{Element, clip};
 use crate::model::{
     BodyDef, BodyMotorDef, ExtraAttributes, JointDef, JointMotorDef, Placement, Robot, RobotBody,
@@ -26,7 +26,7 @@ struct Fields<'a> {
     /// How messages name the element: `<joint> in robot "housenka"`.
     what: String,
     used: Vec<&'static str>,
-    problems: &'a mut Vec<Problem>,
+    problems: &'a mut FileProblems,
     failed: bool,
 }
 
@@ -35,7 +35,7 @@ impl<'a> Fields<'a> {
         element: &'a Element,
         file: &'a str,
         what: String,
-        problems: &'a mut Vec<Problem>,
+        problems: &'a mut FileProblems,
     ) -> Self {
         Self {
             element,
@@ -131,7 +131,7 @@ impl<'a> Fields<'a> {
     }
 }
 
-fn unknown_child(file: &str, parent: &str, child: &Element, problems: &mut Vec<Problem>) {
+fn unknown_child(file: &str, parent: &str, child: &Element, problems: &mut FileProblems) {
     problems.push(
         Problem::warning(
             file,
@@ -151,7 +151,7 @@ fn named(element: &Element, kind: &str) -> String {
 }
 
 pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
-    let mut problems = Vec::new();
+    let mut problems = FileProblems::default();
     let mut records = Vec::new();
     let mut spans = Vec::new();
     let mut skipped = false;
@@ -210,7 +210,7 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
     Read {
         records,
         spans,
-        problems,
+        problems: problems.into_vec(file),
         skipped,
     }
 }
@@ -219,7 +219,7 @@ fn placement(
     el: &Element,
     file: &str,
     what: String,
-    problems: &mut Vec<Problem>,
+    problems: &mut FileProblems,
     aliased: bool,
 ) -> (Placement, bool) {
     let mut f = Fields::new(el, file, what, problems);
@@ -242,7 +242,7 @@ fn placement(
 }
 
 pub fn robots(root: &Element, file: &str) -> Read<Robot> {
-    let mut problems = Vec::new();
+    let mut problems = FileProblems::default();
     let mut records = Vec::new();
     let mut spans = Vec::new();
     let mut skipped = false;
@@ -349,13 +349,13 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
     Read {
         records,
         spans,
-        problems,
+        problems: problems.into_vec(file),
         skipped,
     }
 }
 
 pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
-    let mut problems = Vec::new();
+    let mut problems = FileProblems::default();
     let mut records = Vec::new();
     let mut spans = Vec::new();
     let mut skipped = false;
@@ -416,7 +416,7 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
     Read {
         records,
         spans,
-        problems,
+        problems: problems.into_vec(file),
         skipped,
     }
 }

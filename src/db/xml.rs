@@ -1,7 +1,7 @@
 //! XML syntax only: a file's text becomes a small tree of elements with their attributes
 //! and line/column, or one syntax problem. What the elements mean is `read.rs`'s business.
 
-use super::problem::{Problem, one_line};
+use super::problem::{FileProblems, Problem, one_line};
 use crate::model::Location;
 use quick_xml::XmlVersion;
 use quick_xml::events::{BytesStart, Event};
@@ -152,10 +152,10 @@ pub fn parse(text: &str, file: &str) -> Result<Parsed, Vec<Problem>> {
     let mut skipped = false;
     loop {
         // Each attempt reads the file anew: only the last one's warnings stand.
-        let mut warnings = Vec::new();
+        let mut warnings = FileProblems::default();
         match parse_once(&text, file, &mut warnings) {
             Ok((root, truncated)) => {
-                problems.extend(warnings);
+                problems.extend(warnings.into_vec(file));
                 problems.sort_by_key(|p| p.location.map(|l| (l.line, l.column)));
                 return Ok(Parsed {
                     root,
@@ -228,7 +228,7 @@ fn next_record(text: &str, start: usize, name: &str) -> usize {
 fn parse_once(
     text: &str,
     file: &str,
-    problems: &mut Vec<Problem>,
+    problems: &mut FileProblems,
 ) -> Result<(Element, bool), SyntaxError> {
     let lines = Lines::new(text);
     let mut reader = quick_xml::Reader::from_str(text);
