@@ -357,3 +357,43 @@ fn a_gif_that_cannot_be_written_is_one_line_and_exit_2_and_leaves_no_file() {
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(left.len(), 1, "no temporary file left behind: {left:?}");
 }
+
+/// A name with an escape sequence and a carriage return (issue 63): the CSV stays valid
+/// RFC 4180 and carries no control character, written as JSON writes them.
+#[test]
+fn csv_never_carries_a_control_character_from_a_name() {
+    let db = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        "tests/hostile/cli_arguments/bodies.xml",
+        db.path().join("bodies.xml"),
+    )
+    .unwrap();
+    std::fs::write(
+        db.path().join("scenes.xml"),
+        "<scenes><scene name=\"s\" gravitation=\"10\" friction=\"0.5\">\
+         <body alias=\"red\u{1b}[31m&#13;x\" source=\"box\" x=\"0\" y=\"0\"/></scene></scenes>",
+    )
+    .unwrap();
+    let out = robosim()
+        .args([
+            "run", "--scene", "s", "--steps", "2", "--format", "csv", "--db",
+        ])
+        .arg(db.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        !text.chars().any(|c| c.is_control() && c != '\n'),
+        "{text:?}"
+    );
+    let header = text.lines().next().unwrap();
+    assert!(header.contains("red\\u001b[31m\\u000dx.x"), "{header}");
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
+    let widths: Vec<usize> = reader.records().map(|r| r.unwrap().len()).collect();
+    assert_eq!(widths, [10, 10, 10]);
+}

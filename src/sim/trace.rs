@@ -92,11 +92,16 @@ impl Record {
             .map(String::from)
             .to_vec();
         for b in &self.bodies {
+            let id = without_control_characters(&b.id);
             for field in ["x", "y", "angle", "vx", "vy", "omega"] {
-                header.push(format!("{}.{field}", b.id));
+                header.push(format!("{id}.{field}"));
             }
         }
-        header.extend(self.joints.iter().map(|j| format!("{}.gap", j.id)));
+        header.extend(
+            self.joints
+                .iter()
+                .map(|j| format!("{}.gap", without_control_characters(&j.id))),
+        );
         header
     }
 
@@ -113,4 +118,19 @@ impl Record {
         row.extend(self.joints.iter().map(|j| j.gap.to_string()));
         row
     }
+}
+
+/// `name` with its control characters written as JSON writes them (`\u001b`): a CSV
+/// printed to a terminal must not carry an escape sequence or a carriage return from a
+/// name in the files (the csv crate quotes fields, it does not escape them).
+fn without_control_characters(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        if c.is_control() {
+            out += &format!("\\u{:04x}", c as u32);
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
