@@ -96,7 +96,8 @@ fn parse_step(text: &str) -> Result<f64, String> {
 }
 
 fn parse_solver(name: &str) -> Result<ContactSolver, String> {
-    ContactSolver::from_name(name).ok_or_else(|| {
+    // As a file's `solver=" soft "` is read: the spaces around a name are not part of it.
+    ContactSolver::from_name(name.trim()).ok_or_else(|| {
         let names: Vec<_> = ContactSolver::ALL.iter().map(|s| s.name()).collect();
         format!("unknown solver \"{name}\" (one of {})", names.join(", "))
     })
@@ -281,7 +282,17 @@ pub fn check(db: &Path) -> Result<ExitCode, Failure> {
 pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     require_dir(&args.db)?;
     let (database, problems) = Database::load(&args.db);
-    let errors: Vec<&Problem> = problems.iter().filter(|p| p.is_error()).collect();
+    // Only what the scene uses must be right: the rest of the database is reported in
+    // one line and does not stop the run.
+    // (A scene that did not load may be among the records a broken file lost: then every
+    // error is the scene's business.)
+    let found = database.model.scene(&args.scene).is_some();
+    let scene_problems = if found {
+        database.scene_problems(&args.scene)
+    } else {
+        problems.clone()
+    };
+    let errors: Vec<&Problem> = scene_problems.iter().filter(|p| p.is_error()).collect();
     if let Some(first) = errors.first() {
         let more = if errors.len() > 1 {
             format!(" (and {} more: see robosim check)", errors.len() - 1)
@@ -289,6 +300,15 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             String::new()
         };
         return Err(Failure(format!("{first}{more}")));
+    }
+    let errors_elsewhere = problems.iter().filter(|p| p.is_error()).count();
+    if errors_elsewhere > 0 {
+        let _ = writeln!(
+            std::io::stderr(),
+            "robosim: warning: {}: {errors_elsewhere} errors in records scene \"{}\" does not use (see robosim check)",
+            args.db.display(),
+            crate::db::clip(&args.scene)
+        );
     }
     refuse_unsafe_outputs(args)?;
     let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)

@@ -307,3 +307,25 @@ fn standard_output_on_a_read_write_dev_null_is_open() {
         );
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn a_database_file_linked_to_nothing_is_an_error_not_an_empty_collection() {
+    let dir = copy_of_data();
+    let bodies = dir.path().join("bodies.xml");
+    std::fs::remove_file(&bodies).unwrap();
+    std::os::unix::fs::symlink("gone.xml", &bodies).unwrap();
+    let output = Command::new(ROBOSIM)
+        .args(["check", "--db"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(
+        lines(&output.stdout)[0],
+        format!(
+            "{}: error: file: cannot read: a symbolic link to gone.xml, which does not exist",
+            bodies.display()
+        )
+    );
+}

@@ -20,6 +20,17 @@ pub enum ShapeError {
     TooLarge { extent: f64 },
     #[error("vertices {first} and {second} are the same point")]
     RepeatedPoint { first: usize, second: usize },
+    /// Two vertices apart, but closer than `RELATIVE_TOLERANCE` of the polygon's size:
+    /// a sliver the engine cannot tell from a line.
+    #[error(
+        "vertices {first} and {second} are only {distance:e} apart, less than a billionth of the polygon's size ({size:e}): too thin to simulate"
+    )]
+    TooThin {
+        first: usize,
+        second: usize,
+        distance: f64,
+        size: f64,
+    },
     #[error("the polygon has (nearly) zero area")]
     ZeroArea,
     #[error("edges {first} and {second} cross: the polygon intersects itself")]
@@ -77,10 +88,19 @@ impl ConvexPolygon {
         let same_point = RELATIVE_TOLERANCE * size;
         for i in 0..points.len() {
             for j in i + 1..points.len() {
-                if (points[i] - points[j]).norm() <= same_point {
+                let distance = (points[i] - points[j]).norm();
+                if distance == 0.0 {
                     return Err(ShapeError::RepeatedPoint {
                         first: i,
                         second: j,
+                    });
+                }
+                if distance <= same_point {
+                    return Err(ShapeError::TooThin {
+                        first: i,
+                        second: j,
+                        distance,
+                        size,
                     });
                 }
             }
@@ -434,6 +454,21 @@ mod tests {
                 second: 3
             })
         );
+        // A 1000 x 1e-6 plank: its short edges are a billionth of its size.
+        let plank = [v(0., 0.), v(1000., 0.), v(1000., 1e-6), v(0., 1e-6)];
+        let thin = ConvexPolygon::new(&plank).unwrap_err();
+        assert!(
+            matches!(
+                thin,
+                TooThin {
+                    first: 0,
+                    second: 3,
+                    ..
+                }
+            ),
+            "{thin:?}"
+        );
+        assert!(thin.to_string().contains("too thin"), "{thin}");
         assert_eq!(
             ConvexPolygon::new(&[v(0., 0.), v(1., 1.), v(2., 2.)]),
             Err(ZeroArea)

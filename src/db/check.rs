@@ -248,6 +248,17 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
             );
         }
         check_body_motors(&b.motors, &what, file, out);
+        let is_static = model.body(&p.source).is_some_and(|d| d.density == 0.0);
+        if let Some(m) = b.motors.first().filter(|_| is_static) {
+            out.push(
+                Problem::warning(
+                    file,
+                    &format!("<force> on {what}"),
+                    "the body is static (density 0): its motor turns nothing",
+                )
+                .at(m.location),
+            );
+        }
     }
     // Connectivity by union-find over aliases (thesis §4.1).
     let mut parent: Vec<usize> = (0..robot.bodies.len()).collect();

@@ -246,6 +246,50 @@ impl Database {
         check(&self.model, |kind| self.file_label(kind))
     }
 
+    /// The problems of what scene `name` uses: the scenes of that name, the robots they
+    /// place and the bodies they and their robots place (every record of each name, so
+    /// that a name used twice is still reported). A scene can run whatever is wrong with
+    /// the records it does not use.
+    pub fn scene_problems(&self, name: &str) -> Vec<Problem> {
+        let model = &self.model;
+        let scenes: Vec<_> = model
+            .scenes
+            .iter()
+            .filter(|s| same_name(&s.name, name))
+            .cloned()
+            .collect();
+        let placed_robots: std::collections::HashSet<&str> = scenes
+            .iter()
+            .flat_map(|s| s.robots.iter().map(|r| r.source.trim()))
+            .collect();
+        let robots: Vec<_> = model
+            .robots
+            .iter()
+            .filter(|r| placed_robots.contains(r.name.trim()))
+            .cloned()
+            .collect();
+        let robot_bodies = robots
+            .iter()
+            .flat_map(|r| r.bodies.iter().map(|b| b.placement.source.trim()));
+        let placed_bodies: std::collections::HashSet<&str> = scenes
+            .iter()
+            .flat_map(|s| s.bodies.iter().map(|b| b.source.trim()))
+            .chain(robot_bodies)
+            .collect();
+        let bodies = model
+            .bodies
+            .iter()
+            .filter(|b| placed_bodies.contains(b.name.trim()))
+            .cloned()
+            .collect();
+        let used = Model {
+            bodies,
+            robots,
+            scenes,
+        };
+        check(&used, |kind| self.file_label(kind))
+    }
+
     /// The text each file would have if saved now: each record unchanged since it was
     /// loaded or saved as it is in the file (its numbers as they were written), the
     /// others written anew.
@@ -442,7 +486,20 @@ pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
         use std::os::unix::fs::OpenOptionsExt;
         options.custom_flags(libc::O_NONBLOCK);
     }
-    let file = options.open(path)?;
+    let file = match options.open(path) {
+        Ok(file) => file,
+        // A link to nothing is not a missing file (an empty collection): it is a mistake.
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => match std::fs::read_link(path) {
+            Ok(target) => {
+                return Err(std::io::Error::other(format!(
+                    "a symbolic link to {}, which does not exist",
+                    target.display()
+                )));
+            }
+            Err(_) => return Err(e),
+        },
+        Err(e) => return Err(e),
+    };
     let meta = file.metadata()?;
     if !meta.is_file() {
         return Err(std::io::Error::other(

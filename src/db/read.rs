@@ -181,14 +181,18 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
             }
             let mut f = Fields::new(v, file, format!("<vertex> of {what}"), &mut problems);
             let point = [f.number("x"), f.number("y")];
-            let dropped: Vec<_> = f.extra().into_iter().map(|(k, _)| k).collect();
+            let dropped: Vec<String> = f
+                .extra()
+                .into_iter()
+                .map(|(k, _)| format!("\"{}\"", clip(&k)))
+                .collect();
             failed |= f.failed;
             if !dropped.is_empty() {
                 problems.push(
                     Problem::warning(
                         file,
                         &format!("<vertex> of {what}"),
-                        format!("unknown attributes {dropped:?} are not kept"),
+                        format!("unknown attributes {} are not kept", dropped.join(", ")),
                     )
                     .at(v.location),
                 );

@@ -62,6 +62,14 @@ pub fn decode<'a>(bytes: &'a [u8], file: &str) -> Result<Decoded<'a>, Problem> {
         Some((encoding, bom)) => (encoding, bom),
         None => (declared_encoding(bytes).unwrap_or(encoding_rs::UTF_8), 0),
     };
+    // A declaration read in ASCII cannot be UTF-16 (whose ASCII has a zero byte in every
+    // character, and which begins with a byte-order mark): the file is read as UTF-8.
+    let utf16 = [encoding_rs::UTF_16LE, encoding_rs::UTF_16BE];
+    let (encoding, mislabelled) = if bom == 0 && utf16.contains(&encoding) {
+        (encoding_rs::UTF_8, Some(encoding.name()))
+    } else {
+        (encoding, None)
+    };
     let body = &bytes[bom..];
     if encoding == encoding_rs::UTF_8 {
         let text = std::str::from_utf8(body).map_err(|e| {
@@ -77,9 +85,18 @@ pub fn decode<'a>(bytes: &'a [u8], file: &str) -> Result<Decoded<'a>, Problem> {
             )
             .at(location)
         })?;
+        let warning = mislabelled.map(|declared| {
+            Problem::warning(
+                file,
+                "file",
+                format!(
+                    "declares {declared} but is written in ASCII, with no byte-order mark: read as UTF-8"
+                ),
+            )
+        });
         return Ok(Decoded {
             text: std::borrow::Cow::Borrowed(text),
-            warning: None,
+            warning,
         });
     }
     let (text, had_errors) = encoding.decode_without_bom_handling(body);
@@ -327,7 +344,7 @@ fn parse_once(
                     problems.push(ignored(
                         file,
                         &stack,
-                        format!("text {:?}", clip(&content)),
+                        format!("text \"{}\"", clip(&content)),
                         location,
                     ));
                 }
@@ -367,10 +384,30 @@ fn parse_once(
     match root {
         Some(root) => Ok((root, false)),
         None => Err(fail(
-            Problem::error(file, "file", "no root element (the file is empty)"),
+            Problem::error(file, "file", no_root_because(text)),
             &None,
         )),
     }
+}
+
+/// Why a file has no root element, in terms of what it holds.
+fn no_root_because(text: &str) -> String {
+    let content = text.trim_start_matches('\u{feff}').trim();
+    if content.is_empty() {
+        return "no root element (the file is empty)".to_string();
+    }
+    let what = if content.starts_with('{') || content.starts_with('[') {
+        "JSON or other text, not XML"
+    } else if content.starts_with('<') {
+        "markup but no element (only a declaration, comments or instructions)"
+    } else {
+        "text, not XML"
+    };
+    let beginning: String = content.chars().take(30).collect();
+    format!(
+        "no root element: the file holds {what} (it begins \"{}\")",
+        clip(&beginning)
+    )
 }
 
 fn tag_name(start: &BytesStart) -> String {
