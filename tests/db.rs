@@ -547,6 +547,30 @@ fn generated_monsters_give_errors_not_panics() {
             "1048476 more warnings not listed (the first 100 are)"
         ]
     );
+    // Errors are capped as warnings are: 300 vertices without coordinates.
+    let vertices = format!(
+        "<bodies><body name=\"v\" density=\"1\" cor=\"0\">{}</body></bodies>",
+        "<vertex/>".repeat(300)
+    );
+    let (_, problems, _dir) = load(&[(FileKind::Bodies, vertices.as_bytes())]);
+    let errors: Vec<&str> = problems
+        .iter()
+        .filter(|p| p.is_error())
+        .map(|p| p.message.as_str())
+        .collect();
+    assert_eq!(errors.len(), 101, "{errors:?}");
+    assert!(errors.contains(&"500 more errors not listed (the first 100 are)"));
+    // More elements than any database has: refused as they are counted, before the
+    // tree takes 88 bytes for each 4-byte element.
+    let elements = format!("<bodies>{}</bodies>", "<x/>".repeat((1 << 22) + 1));
+    let (_, problems, _dir) = load(&[(FileKind::Bodies, elements.as_bytes())]);
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.is_error() && p.message.contains("more than 4194304 elements")),
+        "{:?}",
+        &problems[..problems.len().min(3)]
+    );
     // Deep nesting.
     let deep = format!("{}{}", "<a>".repeat(100_000), "</a>".repeat(100_000));
     let (_, problems, _dir) = load(&[(FileKind::Robots, deep.as_bytes())]);

@@ -534,7 +534,12 @@ fn record_texts(text: &str, kind: FileKind) -> Vec<Option<Arc<str>>> {
         .root
         .children
         .iter()
-        .map(|c| c.span.clone().and_then(|r| text.get(r)).map(Arc::from))
+        .map(|c| {
+            c.span
+                .as_deref()
+                .and_then(|r| text.get(r.clone()))
+                .map(Arc::from)
+        })
         .collect()
 }
 

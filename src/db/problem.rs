@@ -89,48 +89,54 @@ impl fmt::Display for Problem {
     }
 }
 
-/// The warnings of one file that are listed; the rest are counted. A file of a million
-/// unknown elements is a million warnings, which no one reads and which took a hundred
-/// times the file's size in memory; errors are all kept (each stops its record).
-pub const WARNINGS_LISTED_PER_FILE: usize = 100;
+/// The problems of each kind (errors, warnings) that one file lists; the rest are
+/// counted. A file of a million unknown or broken elements is a million problems, which
+/// no one reads and which took a hundred times the file's size in memory.
+pub const LISTED_PER_FILE: usize = 100;
 
-/// The problems of one file as it is read, its warnings capped at
-/// [`WARNINGS_LISTED_PER_FILE`].
+/// The problems of one file as it is read, each kind's list capped at [`LISTED_PER_FILE`].
 #[derive(Debug, Default)]
 pub(crate) struct FileProblems {
     listed: Vec<Problem>,
-    warnings_listed: usize,
-    warnings_unlisted: usize,
+    /// Listed and unlisted counts: errors, warnings.
+    errors: (usize, usize),
+    warnings: (usize, usize),
 }
 
 impl FileProblems {
     pub(crate) fn push(&mut self, problem: Problem) {
-        if problem.is_error() {
-            self.listed.push(problem);
-        } else if self.warnings_listed < WARNINGS_LISTED_PER_FILE {
-            self.warnings_listed += 1;
+        let (listed, unlisted) = if problem.is_error() {
+            &mut self.errors
+        } else {
+            &mut self.warnings
+        };
+        if *listed < LISTED_PER_FILE {
+            *listed += 1;
             self.listed.push(problem);
         } else {
-            self.warnings_unlisted += 1;
+            *unlisted += 1;
         }
     }
 
     /// Every problem pushed so far, listed or not.
     pub(crate) fn len(&self) -> usize {
-        self.listed.len() + self.warnings_unlisted
+        self.listed.len() + self.errors.1 + self.warnings.1
     }
 
-    /// The listed problems, and one warning counting the rest, if any, in `file`.
+    /// The listed problems, and one problem of each kind counting the rest, in `file`.
     pub(crate) fn into_vec(self, file: &str) -> Vec<Problem> {
         let mut list = self.listed;
-        if self.warnings_unlisted > 0 {
+        let more = |kind: &str, count: usize| {
+            format!("{count} more {kind} not listed (the first {LISTED_PER_FILE} are)")
+        };
+        if self.errors.1 > 0 {
+            list.push(Problem::error(file, "file", more("errors", self.errors.1)));
+        }
+        if self.warnings.1 > 0 {
             list.push(Problem::warning(
                 file,
                 "file",
-                format!(
-                    "{} more warnings not listed (the first {WARNINGS_LISTED_PER_FILE} are)",
-                    self.warnings_unlisted
-                ),
+                more("warnings", self.warnings.1),
             ));
         }
         list

@@ -206,7 +206,8 @@ pub fn bodies(root: &Element, file: &str) -> Read<BodyDef> {
             // A record read with a problem is written afresh, not as it was.
             spans.push(
                 el.span
-                    .clone()
+                    .as_deref()
+                    .cloned()
                     .filter(|_| problems.len() == problems_before),
             );
         }
@@ -266,7 +267,7 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
         robot.extra = f.extra();
         let mut failed = f.failed;
         for child in &el.children {
-            match child.name.as_str() {
+            match &*child.name {
                 "body" => {
                     let in_robot = format!("<body> in robot \"{}\"", robot.name);
                     let (placement, bad) =
@@ -345,7 +346,8 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
             // A record read with a problem is written afresh, not as it was.
             spans.push(
                 el.span
-                    .clone()
+                    .as_deref()
+                    .cloned()
                     .filter(|_| problems.len() == problems_before),
             );
         }
@@ -384,7 +386,7 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
         let mut failed = f.failed;
         for child in &el.children {
             let in_scene = format!("<{}> in scene \"{}\"", child.name, scene.name);
-            match child.name.as_str() {
+            match &*child.name {
                 "robot" => {
                     let (p, bad) = placement(child, file, in_scene, &mut problems, false);
                     failed |= bad;
@@ -412,7 +414,8 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
             // A record read with a problem is written afresh, not as it was.
             spans.push(
                 el.span
-                    .clone()
+                    .as_deref()
+                    .cloned()
                     .filter(|_| problems.len() == problems_before),
             );
         }

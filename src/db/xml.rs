@@ -9,15 +9,60 @@ use quick_xml::events::{BytesStart, Event};
 /// Deeper than this is not a database (the format nests three levels below the root).
 pub const MAX_DEPTH: usize = 32;
 
+/// More elements than this is not a database: 50,000 bodies of four vertices are 250,000.
+/// It keeps a file of millions of tiny elements (`<x/>`, 4 bytes each, 88 in the tree)
+/// from taking gigabytes before it is found to be nonsense.
+pub const MAX_ELEMENTS: usize = 1 << 22;
+
+/// An element as the reader needs it. Kept small (88 bytes, its name shared with every
+/// element of that name): a file of millions of tiny elements is a tree of millions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Element {
-    pub name: String,
+    pub name: Name,
     pub attributes: Vec<(String, String)>,
     pub children: Vec<Element>,
     pub location: Location,
     /// For a record (a child of the root): its text in the file, from its tag's `<` to
     /// the end of its end tag, so that saving can write an unchanged record as it was.
-    pub span: Option<std::ops::Range<usize>>,
+    pub span: Option<Box<std::ops::Range<usize>>>,
+}
+
+/// An element's name, one allocation shared by every element of that name in a file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Name(std::sync::Arc<str>);
+
+impl std::ops::Deref for Name {
+    type Target = str;
+    fn deref(&self) -> &str {
+        &self.0
+    }
+}
+
+impl std::fmt::Display for Name {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl PartialEq<&str> for Name {
+    fn eq(&self, other: &&str) -> bool {
+        &*self.0 == *other
+    }
+}
+
+/// The names met in one file, each allocated once.
+#[derive(Default)]
+struct Names(std::collections::HashMap<String, Name>);
+
+impl Names {
+    fn of(&mut self, name: &str) -> Name {
+        if let Some(known) = self.0.get(name) {
+            return known.clone();
+        }
+        let new = Name(std::sync::Arc::from(name));
+        self.0.insert(name.to_string(), new.clone());
+        new
+    }
 }
 
 /// Line and column (1-based) of each byte offset of a text.
@@ -252,6 +297,8 @@ fn parse_once(
     reader.config_mut().trim_text(true);
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
+    let mut names = Names::default();
+    let mut elements = 0usize;
     // The record (a child of the root) being read: where its tag starts, and its name.
     let mut record: Option<(usize, String)> = None;
     // Whether the open record holds something ignored: then it has no span, so that saving
@@ -276,6 +323,14 @@ fn parse_once(
         };
         // A tag of the root's own children starts a record.
         let starts_record = |stack: &Vec<Element>| stack.len() == 1;
+        if matches!(event, Event::Start(_) | Event::Empty(_)) {
+            elements += 1;
+            if elements > MAX_ELEMENTS {
+                let message = format!("more than {MAX_ELEMENTS} elements: not a database");
+                let problem = Problem::error(file, "file", message).at(location);
+                return Err(fail(problem, &None));
+            }
+        }
         match event {
             Event::Start(start) | Event::Empty(start) if root.is_some() && stack.is_empty() => {
                 let name = start.name().into_inner().to_string();
@@ -301,16 +356,18 @@ fn parse_once(
                     .at(location);
                     return Err(fail(problem, &record));
                 }
-                let element = element(&start, location, file).map_err(|p| fail(p, &record))?;
+                let element =
+                    element(&start, location, file, &mut names).map_err(|p| fail(p, &record))?;
                 stack.push(element);
             }
             Event::Empty(start) => {
                 if starts_record(&stack) {
                     record = Some((tag_start, tag_name(&start)));
                 }
-                let mut done = element(&start, location, file).map_err(|p| fail(p, &record))?;
+                let mut done =
+                    element(&start, location, file, &mut names).map_err(|p| fail(p, &record))?;
                 if stack.len() == 1 {
-                    done.span = Some(tag_start..reader.buffer_position() as usize);
+                    done.span = Some(Box::new(tag_start..reader.buffer_position() as usize));
                 }
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(done),
@@ -327,7 +384,7 @@ fn parse_once(
                     && let Some((start, _)) = &record
                     && !record_has_ignored
                 {
-                    done.span = Some(*start..reader.buffer_position() as usize);
+                    done.span = Some(Box::new(*start..reader.buffer_position() as usize));
                 }
                 match stack.last_mut() {
                     Some(parent) => parent.children.push(done),
@@ -427,8 +484,13 @@ fn ignored(file: &str, stack: &[Element], what: String, location: Location) -> P
     .at(location)
 }
 
-fn element(start: &BytesStart, location: Location, file: &str) -> Result<Element, Problem> {
-    let name = start.name().into_inner().to_string();
+fn element(
+    start: &BytesStart,
+    location: Location,
+    file: &str,
+    names: &mut Names,
+) -> Result<Element, Problem> {
+    let name = names.of(start.name().into_inner());
     let mut attributes: Vec<(String, String)> = Vec::new();
     for attribute in start.attributes() {
         let attribute = attribute.map_err(|e| {
@@ -461,5 +523,14 @@ pub fn clip(value: &str) -> String {
     } else {
         let head: String = value.chars().take(MAX).collect();
         format!("{}… ({} characters)", one_line(head), value.chars().count())
+    }
+}
+
+#[cfg(test)]
+mod size {
+    /// The element's size, which a file of tiny elements multiplies by millions.
+    #[test]
+    fn an_element_is_88_bytes() {
+        assert_eq!(std::mem::size_of::<super::Element>(), 88);
     }
 }
