@@ -571,6 +571,17 @@ fn generated_monsters_give_errors_not_panics() {
         "{:?}",
         &problems[..problems.len().min(3)]
     );
+    // Control characters in stray text and in attribute names are escaped once.
+    let controls = "<bodies>stray\u{0}text<body name=\"b\" density=\"1\" cor=\"0\"><vertex x=\"0\" y=\"0\" q\u{1}=\"2\"/><vertex x=\"1\" y=\"0\"/><vertex x=\"0\" y=\"1\"/></body></bodies>";
+    let (_, problems, _dir) = load(&[(FileKind::Bodies, controls.as_bytes())]);
+    let messages: Vec<&str> = problems.iter().map(|p| p.message.as_str()).collect();
+    assert_eq!(
+        messages,
+        [
+            "unexpected text \"stray\\u{0}text\", ignored (and not kept when this file is saved)",
+            "unknown attributes \"q\\u{1}\" are not kept"
+        ]
+    );
     // Deep nesting.
     let deep = format!("{}{}", "<a>".repeat(100_000), "</a>".repeat(100_000));
     let (_, problems, _dir) = load(&[(FileKind::Robots, deep.as_bytes())]);
