@@ -230,3 +230,52 @@ fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
     undo(&mut h);
     assert_eq!(*h.state().model(), before);
 }
+
+/// The rotate handle turns a body by the angle the pointer swept about its origin,
+/// however many moves the sweep takes (issue 64: each move added the whole angle since
+/// the press, so a 45° sweep in 4 moves turned 105.6°), and selects nothing on the way.
+#[test]
+fn the_rotate_handle_turns_by_the_angle_swept() {
+    let dir = scratch_db();
+    let mut h = stack_at_step_0(dir.path());
+    click_world(&mut h, 400.0, 305.0, Modifiers::NONE);
+    assert_eq!(picked_ids(&h), ["box 3"]);
+    let (camera, rect) = (h.state().camera(), h.state().canvas_rect());
+    let origin = camera.to_screen(rect, pe::Vec2::new(400.0, 305.0));
+    // The handle: 24 points above the top of the outline (y = 290).
+    let handle = camera.to_screen(rect, pe::Vec2::new(400.0, 290.0)) - egui::vec2(0.0, 24.0);
+    let radius = origin.y - handle.y;
+    for (sweep, moves) in [(45f32, 4), (90f32, 10)] {
+        let before = body(&stack(&h), "box 3").orientation;
+        let at = |degrees: f32| {
+            // Clockwise on screen from straight up (y down: the turn's positive sense).
+            let a = degrees.to_radians();
+            origin + egui::vec2(radius * a.sin(), -radius * a.cos())
+        };
+        h.event(egui::Event::PointerMoved(handle));
+        h.run_steps(1);
+        let button = |pos, pressed| egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        };
+        h.event(button(at(0.0), true));
+        h.run_steps(1);
+        for k in 1..=moves {
+            h.event(egui::Event::PointerMoved(at(
+                sweep * k as f32 / moves as f32
+            )));
+            h.run_steps(1);
+        }
+        h.event(button(at(sweep), false));
+        h.run_steps(2);
+        let turned = body(&stack(&h), "box 3").orientation - before;
+        assert!(
+            (turned - f64::from(sweep).to_radians()).abs() < 0.5f64.to_radians(),
+            "a {sweep}° sweep in {moves} moves turned {}°",
+            turned.to_degrees()
+        );
+        assert_eq!(picked_ids(&h), ["box 3"], "the sweep kept the selection");
+    }
+}
