@@ -301,6 +301,10 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
         };
         return Err(Failure(format!("{first}{more}")));
     }
+    refuse_unsafe_outputs(args)?;
+    let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
+        .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
+    // Said once the run is sure to start, so that a failure stays one line.
     let errors_elsewhere = problems.iter().filter(|p| p.is_error()).count();
     if errors_elsewhere > 0 {
         let _ = writeln!(
@@ -310,9 +314,6 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
             crate::db::clip(&args.scene)
         );
     }
-    refuse_unsafe_outputs(args)?;
-    let mut sim = Simulation::new(&database.model, &args.scene, args.dt, args.solver)
-        .map_err(|e| Failure(format!("{}: {e}", args.db.display())))?;
     sim.world.settings.sleeping = args.sleep;
     let format = args.format.unwrap_or(match &args.out {
         Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("csv")) => Format::Csv,
