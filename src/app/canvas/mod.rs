@@ -175,7 +175,7 @@ impl CanvasView {
         if !self.fitted {
             self.fit_now(scene.sim);
         } else {
-            self.navigate(ui, &response, scene);
+            self.navigate(ui, &response, scene, grab.is_some());
         }
         let mut commands = Vec::new();
         let followed = self.pointer(ui, &response, scene, grab, &mut commands);
@@ -227,15 +227,24 @@ impl CanvasView {
     }
 
     /// Pans with the secondary or middle button, zooms with the wheel about the pointer,
-    /// and eases towards what Follow follows.
-    fn navigate(&mut self, ui: &egui::Ui, response: &egui::Response, scene: Scene<'_>) {
+    /// and eases towards what Follow follows, except while a body is held (`holding`).
+    fn navigate(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        scene: Scene<'_>,
+        holding: bool,
+    ) {
         if pan(&mut self.camera, response) {
             self.debug.follow = false;
         }
         zoom(&mut self.camera, ui, response, self.rect);
-        // Following stops while editing: the view must hold still under the user's clicks.
+        // Following stops while editing, and while a body is held: the view must hold
+        // still under the user's pointer (a view following the held body moves the world
+        // point under a still pointer with it, and the pull never lets up).
         if self.debug.follow
             && !scene.editing
+            && !holding
             && let Some(target) = follow_point(scene.sim, scene.followed, scene.bound)
         {
             // Ease towards the target so that the view does not shake with the bodies.
