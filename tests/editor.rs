@@ -1051,3 +1051,49 @@ fn a_body_pulled_while_following_stays_by_the_pointer() {
     h.event(button(target, false));
     h.run_steps(2);
 }
+
+/// Choosing another body while a scene runs changes what the plots show, not what they
+/// recorded (issue 64): every series goes on from step 0, the new body's included.
+#[test]
+fn choosing_another_body_keeps_every_plot_series_from_step_0() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    open_at_step_0(&mut h, "stack of boxes");
+    click(&mut h, "Play");
+    h.run_steps(30);
+    let recorded = h.state().plot_data().samples.len();
+    assert!(recorded > 10, "{recorded} samples");
+    // Box 1 (the bottom one), then box 5, where they are now (the view held still, so
+    // that the click lands where it was aimed).
+    click(&mut h, "Follow");
+    for id in ["box 1", "box 5"] {
+        let app = h.state();
+        let sim = app.sim().unwrap();
+        let body = sim.bodies.iter().find(|b| b.id == id).unwrap();
+        let at = sim.world.body(body.handle).unwrap().position;
+        let pos = app.camera().to_screen(app.canvas_rect(), at);
+        h.event(Event::PointerMoved(pos));
+        h.run_steps(1);
+        for pressed in [true, false] {
+            h.event(Event::PointerButton {
+                pos,
+                button: PointerButton::Primary,
+                pressed,
+                modifiers: Modifiers::NONE,
+            });
+            h.run_steps(1);
+        }
+    }
+    h.run_steps(5);
+    let app = h.state();
+    let data = app.plot_data();
+    let sim = app.sim().unwrap();
+    let shown = data.shown_body.expect("a body is shown");
+    assert_eq!(sim.bodies[shown].id, "box 5");
+    assert!(data.samples.len() > recorded, "the series went on");
+    assert_eq!(data.samples[0].time, 0.0, "from step 0");
+    assert!(
+        data.samples.iter().all(|s| data.shown_state(s).is_some()),
+        "box 5's series from step 0"
+    );
+}

@@ -68,7 +68,7 @@ impl RoboSimApp {
             Some(owner) => self.bodies_of(&[owner]),
             None => body.into_iter().collect(),
         };
-        self.runner.restart_plots(body);
+        self.runner.show_in_plots(body);
     }
 
     /// Selects the placements behind `bodies` (a rubber band); with `add`, besides those
@@ -107,7 +107,7 @@ impl RoboSimApp {
         self.picked = self.bodies_of(owners);
         if !self.followed.is_some_and(|f| self.picked.contains(&f)) {
             self.followed = self.picked.first().copied();
-            self.runner.restart_plots(self.followed);
+            self.runner.show_in_plots(self.followed);
         }
     }
 

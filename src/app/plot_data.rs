@@ -9,11 +9,20 @@ pub struct Sample {
     pub kinetic: f64,
     pub potential: f64,
     pub max_joint_gap: f64,
-    /// The selected body's reference point, velocity and angle, if a body is selected.
-    pub body: Option<[f64; 6]>,
+    /// Bodies' reference points, angles and velocities (`BodyState`), by index into
+    /// `sim.bodies`: every body's in a scene of up to [`EVERY_BODY_LIMIT`], so that
+    /// choosing another body shows its whole run; in bigger scenes the followed one's.
+    pub bodies: Vec<(u32, BodyState)>,
     /// Every motor's torque, in `Simulation::motor_torques` order.
     pub torques: Vec<f64>,
 }
+
+/// A body's reference point, angle and velocities: x, y, angle, vx, vy, ω.
+pub type BodyState = [f64; 6];
+
+/// Scenes of up to this many bodies keep every body's series (a robot scene: 20,000
+/// samples of 32 bodies are 36 MB at most).
+pub const EVERY_BODY_LIMIT: usize = 32;
 
 /// Samples kept for the plots; the oldest half is thinned out when full, so a long run
 /// keeps its whole shape at half the resolution.
@@ -21,6 +30,8 @@ pub struct Sample {
 pub struct PlotData {
     pub samples: Vec<Sample>,
     pub motor_names: Vec<String>,
+    /// The body the plots and the CSV show (index into `sim.bodies`).
+    pub shown_body: Option<usize>,
 }
 
 const CAPACITY: usize = 20_000;
@@ -31,26 +42,44 @@ impl PlotData {
         self.motor_names.clear();
     }
 
-    pub fn record(&mut self, sim: &Simulation, selected: Option<usize>) {
+    /// Shows body `body` from now on; its series from step 0 where every body is kept.
+    pub fn show_body(&mut self, body: Option<usize>) {
+        self.shown_body = body;
+    }
+
+    /// The shown body's state in sample `s`, if it was recorded there.
+    pub fn shown_state(&self, s: &Sample) -> Option<BodyState> {
+        let shown = self.shown_body? as u32;
+        s.bodies.iter().find(|(i, _)| *i == shown).map(|(_, b)| *b)
+    }
+
+    pub fn record(&mut self, sim: &Simulation, followed: Option<usize>) {
+        self.shown_body = followed;
         let metrics = sim.metrics();
         let torques = sim.motor_torques();
         if self.motor_names.len() != torques.len() {
             self.motor_names = torques.iter().map(|t| t.id.clone()).collect();
         }
-        let body = selected
-            .and_then(|i| sim.bodies.get(i))
-            .and_then(|b| sim.world.body(b.handle))
-            .map(|b| {
-                let origin = b.origin();
-                let v = b.velocity_at(origin);
-                [origin.x, origin.y, b.angle, v.x, v.y, b.angular_velocity]
-            });
+        let state = |i: usize| {
+            let b = sim.world.body(sim.bodies.get(i)?.handle)?;
+            let origin = b.origin();
+            let v = b.velocity_at(origin);
+            Some((
+                i as u32,
+                [origin.x, origin.y, b.angle, v.x, v.y, b.angular_velocity],
+            ))
+        };
+        let bodies = if sim.bodies.len() <= EVERY_BODY_LIMIT {
+            (0..sim.bodies.len()).filter_map(state).collect()
+        } else {
+            followed.and_then(state).into_iter().collect()
+        };
         self.samples.push(Sample {
             time: metrics.time,
             kinetic: metrics.kinetic,
             potential: metrics.potential,
             max_joint_gap: metrics.max_joint_gap,
-            body,
+            bodies,
             torques: torques.iter().map(|t| t.torque).collect(),
         });
         if self.samples.len() > CAPACITY {

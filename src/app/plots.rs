@@ -1,7 +1,7 @@
 //! The plots under the canvas: energy, the followed body and the motors, each quantity on
 //! an axis of its own unit with readable numbers, and their export to CSV.
 
-use super::plot_data::{PlotData, Sample};
+use super::plot_data::{BodyState, PlotData, Sample};
 use egui_plot::{GridInput, GridMark, Legend, Line, Plot};
 use std::ops::RangeInclusive;
 
@@ -158,7 +158,10 @@ fn body_plot(ui: &mut egui::Ui, data: &PlotData, quantity: BodyQuantity) {
     let lines = quantity
         .lines()
         .iter()
-        .map(|&(name, k)| (name.to_string(), data.series(|s| s.body.map(|b| b[k]))))
+        .map(|&(name, k)| {
+            let values = data.series(|s| data.shown_state(s).map(|b| b[k]));
+            (name.to_string(), values)
+        })
         .collect();
     plot("body", ui, data, unit, lines);
 }
@@ -320,20 +323,20 @@ pub fn to_csv(data: &PlotData) -> String {
     );
     out.push('\n');
     for s in &data.samples {
-        out.push_str(&row(s, data.motor_names.len()).join(","));
+        out.push_str(&row(s, data.shown_state(s), data.motor_names.len()).join(","));
         out.push('\n');
     }
     out
 }
 
-fn row(s: &Sample, motors: usize) -> Vec<String> {
+fn row(s: &Sample, body: Option<BodyState>, motors: usize) -> Vec<String> {
     let mut row = vec![
         s.time.to_string(),
         s.kinetic.to_string(),
         s.potential.to_string(),
         s.max_joint_gap.to_string(),
     ];
-    match s.body {
+    match body {
         Some(b) => row.extend(b.iter().map(|v| v.to_string())),
         None => row.extend(std::iter::repeat_n(String::new(), 6)),
     }

@@ -257,12 +257,10 @@ impl Runner {
         self.remember();
     }
 
-    /// The plots start again from now, following `followed`.
-    pub fn restart_plots(&mut self, followed: Option<usize>) {
-        self.plot_data.clear();
-        if let Some(sim) = &self.sim {
-            self.plot_data.record(sim, followed);
-        }
+    /// The plots show `followed` from now on; every series is kept (choosing a body
+    /// changes what is shown, not what was recorded).
+    pub fn show_in_plots(&mut self, followed: Option<usize>) {
+        self.plot_data.show_body(followed);
     }
 
     pub fn set_solver(&mut self, solver: ContactSolver) {
