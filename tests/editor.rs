@@ -1097,3 +1097,26 @@ fn choosing_another_body_keeps_every_plot_series_from_step_0() {
         "box 5's series from step 0"
     );
 }
+
+/// The toolbar's solver is the scene's shown (issue 64): chosen for one scene, it stayed
+/// for every other scene until restart while their inspectors said `auto`.
+#[test]
+fn the_toolbar_solver_stays_with_the_scene_it_was_chosen_for() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    open_at_step_0(&mut h, "stack of boxes");
+    let solver =
+        |h: &Harness<'_, RoboSimApp>| h.state().sim().unwrap().world.settings.contact_solver;
+    assert_eq!(solver(&h), pe::ContactSolver::Auto);
+    h.get_by_label_contains("The contact solver").click();
+    h.run_steps(2);
+    h.get_by_label("exact").click();
+    h.run_steps(2);
+    assert_eq!(solver(&h), pe::ContactSolver::Exact);
+    // Reset keeps it for this scene.
+    click(&mut h, "Reset");
+    assert_eq!(solver(&h), pe::ContactSolver::Exact);
+    // Another scene starts from its own (the default: auto).
+    open_at_step_0(&mut h, "walker");
+    assert_eq!(solver(&h), pe::ContactSolver::Auto);
+}

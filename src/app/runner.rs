@@ -50,6 +50,10 @@ pub struct Runner {
     /// Simulated time owed to the physics: real time × speed, paid in whole steps.
     accumulator: f64,
     pub solver: ContactSolver,
+    /// What the solver was chosen for: the scene (or preview) shown, and the solver its
+    /// file names. Another one shown, or its own solver changed, takes up its own solver
+    /// (or the default), not the last one's choice.
+    solver_for: Option<(String, Option<ContactSolver>)>,
     /// Whether bodies at rest sleep in the simulations the app runs.
     pub sleeping: bool,
     /// The body held by the mouse while running.
@@ -72,6 +76,7 @@ impl Default for Runner {
             speed: 1.0,
             accumulator: 0.0,
             solver: ContactSolver::default(),
+            solver_for: None,
             sleeping: true,
             grab: None,
             world_bound: None,
@@ -130,12 +135,16 @@ impl Runner {
             }
             Selection::Body(name) => (preview(model, None, Some(name)), PREVIEW.to_string(), false),
         };
-        if let Some(own) = model
+        let own = model
             .scene(&scene)
             .and_then(|s| s.solver.as_deref())
-            .and_then(ContactSolver::from_name)
-        {
-            self.solver = own;
+            .and_then(|name| ContactSolver::from_name(name.trim()));
+        // The toolbar's choice stays with what it was made for (through edits and
+        // resets); another scene shown starts from its own solver.
+        let shown = (format!("{selection:?}"), own);
+        if self.solver_for.as_ref() != Some(&shown) {
+            self.solver = own.unwrap_or_default();
+            self.solver_for = Some(shown);
         }
         self.running = run;
         let built = Simulation::new(&model, &scene, None, Some(self.solver));
@@ -266,7 +275,7 @@ impl Runner {
     pub fn set_solver(&mut self, solver: ContactSolver) {
         self.solver = solver;
         if let Some(sim) = &mut self.sim {
-            sim.world.settings.contact_solver = solver;
+            sim.set_solver(solver);
         }
     }
 

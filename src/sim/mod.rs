@@ -313,6 +313,12 @@ impl Simulation {
         Ok(())
     }
 
+    /// Solves contacts with `solver` from the next step on, and after `reset`.
+    pub fn set_solver(&mut self, solver: ContactSolver) {
+        self.solver = solver;
+        self.world.settings.contact_solver = solver;
+    }
+
     /// Back to the scene's first state.
     pub fn reset(&mut self) {
         let (model, name, dt, solver) = (
