@@ -120,7 +120,9 @@ impl PlotsPanel {
                     for q in [MotorQuantity::Torque, MotorQuantity::JointGap] {
                         ui.selectable_value(&mut self.motors, q, q.label());
                     }
-                });
+                })
+                .response
+                .on_hover_text("The motors' torques, or the widest joint gap");
             motor_plot(&mut cols[2], data, self.motors);
         });
         command

@@ -120,20 +120,18 @@ impl Runner {
         !self.running && self.sim.as_ref().is_some_and(|s| s.step_count() == 0)
     }
 
-    /// Builds what `selection` shows from `model`: a scene runs, a robot or a body is
-    /// previewed paused. A scene's own solver is taken up. Err: why it cannot be built.
+    /// Builds what `selection` shows from `model`, paused at step 0: a scene, or a robot
+    /// or a body previewed. A scene's own solver is taken up. Err: why it cannot be built.
     pub fn show(
         &mut self,
         model: &Model,
         selection: &Selection,
         followed: Option<usize>,
     ) -> Result<(), String> {
-        let (model, scene, run) = match selection {
-            Selection::Scene(name) => (model.clone(), name.clone(), true),
-            Selection::Robot(name) => {
-                (preview(model, Some(name), None), PREVIEW.to_string(), false)
-            }
-            Selection::Body(name) => (preview(model, None, Some(name)), PREVIEW.to_string(), false),
+        let (model, scene) = match selection {
+            Selection::Scene(name) => (model.clone(), name.clone()),
+            Selection::Robot(name) => (preview(model, Some(name), None), PREVIEW.to_string()),
+            Selection::Body(name) => (preview(model, None, Some(name)), PREVIEW.to_string()),
         };
         let own = model
             .scene(&scene)
@@ -146,7 +144,8 @@ impl Runner {
             self.solver = own.unwrap_or_default();
             self.solver_for = Some(shown);
         }
-        self.running = run;
+        // Shown paused at step 0, scenes too: the user looks, then presses Play (Space).
+        self.running = false;
         let built = Simulation::new(&model, &scene, None, Some(self.solver));
         let result = match built {
             Ok(mut sim) => {

@@ -88,7 +88,9 @@ fn settings(ui: &mut Ui, scene: &mut Scene, edit: &mut Edit) {
                             edit.touched("solver".into(), true);
                         }
                     }
-                });
+                })
+                .response
+                .on_hover_text("This scene's own contact solver, saved in its file");
             ui.end_row();
         });
 }
