@@ -1127,3 +1127,33 @@ fn the_toolbar_solver_stays_with_the_scene_it_was_chosen_for() {
     open_at_step_0(&mut h, "walker");
     assert_eq!(solver(&h), pe::ContactSolver::Auto);
 }
+
+/// Gravity, friction and the step change while a scene runs, without starting it again
+/// (issue 64: any edit reset the run to step 0); other edits build it again at step 0.
+#[test]
+fn a_running_scene_takes_up_gravity_and_friction_as_it_runs() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    click(&mut h, "Play");
+    h.run_steps(20);
+    let before = h.state().sim().unwrap().step_count();
+    assert!(before > 5, "{before} steps");
+    type_into(&mut h, "gravitation", "50");
+    type_into(&mut h, "friction μ", "0.2");
+    let sim = h.state().sim().unwrap();
+    assert!(
+        sim.step_count() >= before,
+        "the run went on: {}",
+        sim.step_count()
+    );
+    assert_eq!(sim.world.gravity.y, 50.0);
+    assert_eq!(sim.world.friction, 0.2);
+    assert!(h.state().is_running());
+    // Reset starts the edited scene again, with the new gravity.
+    click(&mut h, "Pause");
+    click(&mut h, "Reset");
+    let sim = h.state().sim().unwrap();
+    assert_eq!((sim.step_count(), sim.world.gravity.y), (0, 50.0));
+}

@@ -85,13 +85,13 @@ impl RoboSimApp {
 
     fn undo(&mut self) {
         if self.doc.undo() {
-            self.model_changed();
+            self.model_edited();
         }
     }
 
     fn redo(&mut self) {
         if self.doc.redo() {
-            self.model_changed();
+            self.model_edited();
         }
     }
 

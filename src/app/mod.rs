@@ -308,6 +308,16 @@ impl RoboSimApp {
     /// same field soon after) and rebuilds what the canvas shows.
     fn commit(&mut self, draft: Model, key: &str, now: f64) {
         if self.doc.commit(draft, key, now) {
+            self.model_edited();
+        }
+    }
+
+    /// After an edit (or its undo): a running scene takes it up as it runs where it can
+    /// (gravity, friction, the step, joint motors), else what the canvas shows is built
+    /// again.
+    pub(super) fn model_edited(&mut self) {
+        let showing_scene = matches!(self.selection, Some(Selection::Scene(_)));
+        if !(showing_scene && self.runner.follow_live_edit(self.doc.model())) {
             self.model_changed();
         }
     }

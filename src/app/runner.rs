@@ -217,6 +217,20 @@ impl Runner {
         self.apply_throttle();
     }
 
+    /// Takes up an edit of `model` without starting again where the scene shown has run
+    /// (see `Simulation::follow_live_edit`: gravity, friction, the step, joint motors);
+    /// false where it must be built again.
+    pub fn follow_live_edit(&mut self, model: &Model) -> bool {
+        let Some(sim) = &mut self.sim else {
+            return false;
+        };
+        if sim.step_count() == 0 || !sim.follow_live_edit(model) {
+            return false;
+        }
+        self.apply_throttle();
+        true
+    }
+
     /// Every joint motor at `throttle` × its speed in the files (rad/step ÷ h).
     fn apply_throttle(&mut self) {
         let throttle = self.throttle;

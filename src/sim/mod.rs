@@ -4,7 +4,7 @@
 pub mod trace;
 
 use crate::db::{self, clip};
-use crate::model::{BodyMotorDef, JointDef, Model, Placement, Robot, Scene, SceneRobot};
+use crate::model::{BodyMotorDef, JointDef, Model, Placement, Robot, Scene, SceneRobot, same_name};
 use pe::{BodyDef, BodyHandle, ContactSolver, JointHandle, JointMotor, Vec2, World};
 
 /// Why a scene cannot be simulated.
@@ -43,6 +43,8 @@ pub struct SimJoint {
     pub handle: JointHandle,
     /// The motor's window in steps and target in radians per step, if it has one.
     pub motor_window: Option<(u64, u64, f64)>,
+    /// The joint in the files: the scene's `robot`-th `<robot>`, its `joint`-th joint.
+    pub defined_by: (usize, usize),
 }
 
 /// What one step looked like.
@@ -241,7 +243,7 @@ impl Simulation {
             }
         }
         let aliases = robot.alias_index();
-        for j in &robot.joints {
+        for (k, j) in robot.joints.iter().enumerate() {
             let id = format!("{prefix}/{}-{}", j.body_a.trim(), j.body_b.trim());
             let find = |alias: &str| aliases.get(alias.trim()).copied();
             let (Some(a), Some(b)) = (find(&j.body_a), find(&j.body_b)) else {
@@ -250,7 +252,7 @@ impl Simulation {
             let (ha, hb) = (handles[a], handles[b]);
             let point = j.point(&robot.bodies[a].placement);
             let (anchor, _) = compose(frame, (point[0], point[1], 0.0));
-            self.add_joint(id, ha, hb, anchor, j)?;
+            self.add_joint(id, (i, k), ha, hb, anchor, j)?;
         }
         Ok(())
     }
@@ -283,6 +285,7 @@ impl Simulation {
     fn add_joint(
         &mut self,
         id: String,
+        defined_by: (usize, usize),
         a: BodyHandle,
         b: BodyHandle,
         anchor: Vec2,
@@ -309,8 +312,70 @@ impl Simulation {
             id,
             handle,
             motor_window,
+            defined_by,
         });
         Ok(())
+    }
+
+    /// Takes up, without starting again, the changes of `model` that a running scene can
+    /// follow (as Algodoo does): the scene's gravitation, friction and step, and its
+    /// robots' joint motors' speeds and torques. False, and nothing changed, if anything
+    /// else differs or a new number is one the scene may not have: then it is to be
+    /// built again.
+    pub fn follow_live_edit(&mut self, model: &Model) -> bool {
+        // Both models with what may change live set aside must be equal.
+        let set_aside = |m: &Model| {
+            let mut m = m.clone();
+            if let Some(s) = m
+                .scenes
+                .iter_mut()
+                .find(|s| same_name(&s.name, &self.scene_name))
+            {
+                (s.gravitation, s.friction, s.timestep) = (0.0, 0.0, None);
+            }
+            for j in m.robots.iter_mut().flat_map(|r| &mut r.joints) {
+                if let Some(motor) = &mut j.motor {
+                    (motor.angular, motor.max_torque) = (0.0, 0.0);
+                }
+            }
+            m
+        };
+        let Some(scene) = model.scene(&self.scene_name) else {
+            return false;
+        };
+        let dt = scene.timestep();
+        if set_aside(model) != set_aside(&self.model)
+            || !db::scene_number_problems(scene).is_empty()
+            || db::timestep_problem(dt).is_some()
+        {
+            return false;
+        }
+        let mut motors = Vec::new();
+        for j in &self.joints {
+            let (r, k) = j.defined_by;
+            let robot = scene.robots.get(r).and_then(|p| model.robot(&p.source));
+            let def = robot.and_then(|robot| robot.joints.get(k)?.motor.as_ref());
+            if let Some(m) = def {
+                if !db::joint_motor_problems(m).is_empty() {
+                    return false;
+                }
+                motors.push((j.handle, m.clone()));
+            }
+        }
+        self.world.gravity = Vec2::new(0.0, scene.gravitation);
+        self.world.friction = scene.friction;
+        self.dt = dt;
+        for (handle, m) in motors {
+            if let Some(motor) = self.world.joint_motor_mut(handle) {
+                motor.target_speed = m.angular / dt;
+                motor.max_torque = m.max_torque;
+            }
+            if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
+                j.motor_window = Some((m.time0, m.time1, m.angular));
+            }
+        }
+        self.model = model.clone();
+        true
     }
 
     /// Solves contacts with `solver` from the next step on, and after `reset`.
