@@ -1157,3 +1157,52 @@ fn a_running_scene_takes_up_gravity_and_friction_as_it_runs() {
     let sim = h.state().sim().unwrap();
     assert_eq!((sim.step_count(), sim.world.gravity.y), (0, 50.0));
 }
+
+/// Scrubbing back holds still under a held pointer (issue 64): each move dropped the run
+/// after the step shown, the slider's range shrank under the pointer, and a 5-point drag
+/// drifted from 7.2 s to 2.2 s. The run after the step shown goes only when it goes on.
+#[test]
+fn the_back_slider_holds_the_step_under_a_still_pointer() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    click(&mut h, "Play");
+    h.state_mut().set_speed(8.0);
+    h.run_steps(120);
+    click(&mut h, "Pause");
+    let slider = h.get_by_label("back").rect();
+    let newest = h.state().sim().unwrap().step_count();
+    // Press at the slider's right end, move 20 points left, and hold for 30 frames.
+    let start = egui::pos2(slider.right() as f32 - 2.0, slider.center().y as f32);
+    let end = start - egui::vec2(20.0, 0.0);
+    h.event(Event::PointerMoved(start));
+    h.run_steps(1);
+    let button = |pos, pressed| Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    };
+    h.event(button(start, true));
+    h.run_steps(1);
+    for k in 1..=5 {
+        h.event(Event::PointerMoved(
+            start + (end - start) * (k as f32 / 5.0),
+        ));
+        h.run_steps(1);
+    }
+    let shown = h.state().sim().unwrap().step_count();
+    assert!(shown < newest, "scrubbed back from {newest} to {shown}");
+    for _ in 0..30 {
+        h.event(Event::PointerMoved(end));
+        h.run_steps(1);
+        assert_eq!(h.state().sim().unwrap().step_count(), shown, "held still");
+    }
+    h.event(button(end, false));
+    h.run_steps(2);
+    assert_eq!(h.state().sim().unwrap().step_count(), shown);
+    // Going on from there drops what came after it.
+    click(&mut h, "Step");
+    assert_eq!(h.state().sim().unwrap().step_count(), shown + 1);
+}

@@ -64,6 +64,8 @@ pub struct Runner {
     overlaps: Vec<(usize, usize)>,
     /// Snapshots of the last seconds of the run, oldest first, to scrub back through.
     history: VecDeque<(Simulation, Option<WorldBound>)>,
+    /// The snapshot shown after scrubbing back, until the run goes on from it.
+    scrubbed_to: Option<usize>,
     /// Joint motors run at this multiple of their speed in the files (arrow keys).
     throttle: f64,
 }
@@ -83,6 +85,7 @@ impl Default for Runner {
             plot_data: PlotData::default(),
             overlaps: Vec::new(),
             history: VecDeque::new(),
+            scrubbed_to: None,
             throttle: 1.0,
         }
     }
@@ -183,6 +186,10 @@ impl Runner {
     }
 
     /// Back to the latest snapshot at or before `step`, paused; later ones are dropped.
+    /// Shows the snapshot at `step` (or the last before it), paused. The history stays
+    /// whole while the user scrubs, so that the slider's range, and the step under the
+    /// pointer, hold still; the run from there is dropped only when it goes on
+    /// (`leave_scrub`).
     pub fn scrub_to(&mut self, step: u64) {
         let Some(k) = self
             .history
@@ -191,15 +198,24 @@ impl Runner {
         else {
             return;
         };
-        self.history.truncate(k + 1);
         let (sim, bound) = self.history[k].clone();
-        let time = sim.time();
-        self.plot_data.samples.retain(|s| s.time <= time + 1e-9);
         self.sim = Some(sim);
         self.world_bound = bound;
+        self.scrubbed_to = Some(k);
         self.running = false;
         self.grab = None;
         self.accumulator = 0.0;
+    }
+
+    /// Going on from a scrubbed-to step: the snapshots and plot samples after it go.
+    fn leave_scrub(&mut self) {
+        let Some(k) = self.scrubbed_to.take() else {
+            return;
+        };
+        self.history.truncate(k + 1);
+        if let Some(time) = self.sim.as_ref().map(Simulation::time) {
+            self.plot_data.samples.retain(|s| s.time <= time + 1e-9);
+        }
     }
 
     pub fn throttle(&self) -> f64 {
@@ -266,6 +282,7 @@ impl Runner {
 
     fn restarted(&mut self, followed: Option<usize>) {
         self.history.clear();
+        self.scrubbed_to = None;
         self.throttle = 1.0;
         let at_start = self.sim.as_ref().filter(|s| s.step_count() == 0);
         self.overlaps = at_start.map_or_else(Vec::new, placing::overlapping_pairs);
@@ -318,6 +335,7 @@ impl Runner {
 
     /// One physics step, with the mouse spring applied first and the world bound after.
     pub fn step(&mut self, followed: Option<usize>) -> Option<RunNote> {
+        self.leave_scrub();
         let sim = self.sim.as_mut()?;
         if let Some(grab) = &self.grab {
             grab.apply(sim);
