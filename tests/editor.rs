@@ -1174,7 +1174,7 @@ fn the_back_slider_holds_the_step_under_a_still_pointer() {
     let slider = h.get_by_label("back").rect();
     let newest = h.state().sim().unwrap().step_count();
     // Press at the slider's right end, move 20 points left, and hold for 30 frames.
-    let start = egui::pos2(slider.right() as f32 - 2.0, slider.center().y as f32);
+    let start = egui::pos2(slider.right() - 2.0, slider.center().y);
     let end = start - egui::vec2(20.0, 0.0);
     h.event(Event::PointerMoved(start));
     h.run_steps(1);
