@@ -51,8 +51,9 @@ pub struct BodyMotorDef {
     pub location: Location,
 }
 
-/// A joint motor (extension: `<motor>` inside `<joint>`): drives ω_A − ω_B to `angular`
-/// (radians per step) with at most `maxTorque`, reacting on both bodies.
+/// A joint motor (extension: `<motor>` inside `<joint>`): drives body B's angular velocity
+/// relative to body A, ω_B − ω_A, to `angular` (radians per step; positive turns the way
+/// a positive orientation does) with at most `maxTorque`, reacting on both bodies.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct JointMotorDef {
     pub time0: u64,

@@ -286,7 +286,8 @@ fn a_two_body_robot_with_a_joint_and_a_motor_simulates() {
             .unwrap()
             .angular_velocity
     });
-    let relative = (a - b) * sim.dt; // rad per step, the motor's unit
+    // B relative to A, rad per step: the motor's unit and sign.
+    let relative = (b - a) * sim.dt;
     assert!(
         (relative - motor.angular).abs() < 0.01 * motor.angular.abs(),
         "relative speed {relative} rad/step, target {}",

@@ -261,7 +261,7 @@ impl Runner {
             .collect();
         for (handle, angular) in motors {
             if let Some(m) = sim.world.joint_motor_mut(handle) {
-                m.target_speed = throttle * angular / dt;
+                m.target_speed = throttle * crate::sim::pe_joint_speed(angular, dt);
             }
         }
     }

@@ -106,6 +106,14 @@ fn make_unique<'a>(ids: impl Iterator<Item = &'a mut String>) {
     }
 }
 
+/// A joint motor's `angular` (radians per step; positive: body B turns the way a
+/// positive `orientation` turns, relative to body A, as a body motor's positive speed
+/// turns its body, and as Box2D's motor speed is) as pe's target speed (rad/s of
+/// ω_A − ω_B).
+pub fn pe_joint_speed(angular: f64, dt: f64) -> f64 {
+    -angular / dt
+}
+
 /// A placement composed with a parent frame (`model::compose`), as a position and angle.
 fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (Vec2, f64) {
     let (x, y, angle) = crate::model::compose(frame, local);
@@ -300,7 +308,7 @@ impl Simulation {
             }
             def.motor = Some(JointMotor {
                 enabled: (m.time0..m.time1).contains(&0),
-                ..JointMotor::new(m.angular / self.dt, m.max_torque)
+                ..JointMotor::new(pe_joint_speed(m.angular, self.dt), m.max_torque)
             });
             motor_window = Some((m.time0, m.time1, m.angular));
         }
@@ -367,7 +375,7 @@ impl Simulation {
         self.dt = dt;
         for (handle, m) in motors {
             if let Some(motor) = self.world.joint_motor_mut(handle) {
-                motor.target_speed = m.angular / dt;
+                motor.target_speed = pe_joint_speed(m.angular, dt);
                 motor.max_torque = m.max_torque;
             }
             if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
@@ -480,7 +488,8 @@ impl Simulation {
             if let Some(m) = self.world.joint(j.handle).and_then(|j| j.motor) {
                 out.push(MotorTorque {
                     id: j.id.clone(),
-                    torque: m.step_impulse / self.dt,
+                    // pe's impulse drives ω_A − ω_B; the files' sign is B's relative to A.
+                    torque: -m.step_impulse / self.dt,
                 });
             }
         }

@@ -150,11 +150,14 @@ pub fn body_motor_fields(
             });
             ui.end_row();
             ui.label("speed")
-                .on_hover_text("Target speed; the sign gives the direction");
-            edit.touched(
-                format!("{key} w"),
-                units.speed(ui, &mut m.angular).changed(),
-            );
+                .on_hover_text("Target speed; positive turns the way a positive orientation does");
+            ui.horizontal(|ui| {
+                edit.touched(
+                    format!("{key} w"),
+                    units.speed(ui, &mut m.angular).changed(),
+                );
+                ui.label(turn_arrow(m.angular, "", ""));
+            });
             ui.end_row();
             ui.label("torque");
             ui.horizontal(|ui| {
@@ -246,7 +249,9 @@ pub fn joint_fields(
             let mut has = j.motor.is_some();
             if ui
                 .checkbox(&mut has, "joint motor")
-                .on_hover_text("Drives ω_A − ω_B with a bounded torque, reacting on both")
+                .on_hover_text(
+                    "Turns body B relative to body A with a bounded torque, reacting on both",
+                )
                 .changed()
             {
                 j.motor = has.then(|| JointMotorDef {
@@ -273,11 +278,16 @@ pub fn joint_fields(
                     );
                 });
                 ui.end_row();
-                ui.label("speed");
-                edit.touched(
-                    format!("{key} mw"),
-                    units.speed(ui, &mut m.angular).changed(),
+                ui.label("speed").on_hover_text(
+                    "Body B's speed relative to body A; positive turns the way a positive orientation does, as a body motor's positive speed",
                 );
+                ui.horizontal(|ui| {
+                    edit.touched(
+                        format!("{key} mw"),
+                        units.speed(ui, &mut m.angular).changed(),
+                    );
+                    ui.label(turn_arrow(m.angular, &j.body_b, &j.body_a));
+                });
                 ui.end_row();
                 ui.label("max torque");
                 edit.touched(
@@ -292,6 +302,23 @@ pub fn joint_fields(
                 ui.end_row();
             }
         });
+}
+
+/// Which way a motor of speed `angular` turns `body` (relative to `other`, if any), as
+/// the canvas shows it (y down: a positive orientation turns clockwise on screen).
+pub fn turn_arrow(angular: f64, body: &str, other: &str) -> String {
+    let way = if angular > 0.0 {
+        "clockwise"
+    } else if angular < 0.0 {
+        "anticlockwise"
+    } else {
+        return "stands still".to_string();
+    };
+    if other.is_empty() {
+        format!("{way} on screen")
+    } else {
+        format!("{} {way} against {}", body.trim(), other.trim())
+    }
 }
 
 /// Every motor's window on one time axis (steps).
