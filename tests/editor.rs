@@ -1207,3 +1207,71 @@ fn the_back_slider_holds_the_step_under_a_still_pointer() {
     click(&mut h, "Step");
     assert_eq!(h.state().sim().unwrap().step_count(), shown + 1);
 }
+
+/// Follow follows what moves: with a static body selected (terrain just drawn), the view
+/// follows the moving bodies, not the terrain (issue 64).
+#[test]
+fn follow_with_terrain_selected_follows_the_moving_robot() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    open_at_step_0(&mut h, "car on terrain");
+    // A point in view on a static body, to click: a grid over the canvas searched.
+    let terrain = {
+        let app = h.state();
+        let sim = app.sim().unwrap();
+        let (rect, camera) = (app.canvas_rect(), app.camera());
+        let inside = |p: pe::Vec2| {
+            sim.world.bodies().any(|(_, b)| {
+                let v: Vec<pe::Vec2> = b.world_vertices().collect();
+                b.is_static()
+                    && (0..v.len()).all(|k| {
+                        let (a, c) = (v[k], v[(k + 1) % v.len()]);
+                        (c - a).perp(&(p - a)) >= 0.0
+                    })
+            })
+        };
+        (1..20)
+            .flat_map(|i| (1..20).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let screen = rect.min + rect.size() * egui::vec2(i as f32, j as f32) / 20.0;
+                camera.to_world(rect, screen)
+            })
+            .find(|&p| inside(p))
+            .expect("a static body in view")
+    };
+    click_world(&mut h, terrain.x, terrain.y, Modifiers::NONE);
+    let followed = h.state().followed().expect("the terrain is selected");
+    assert!(
+        h.state()
+            .sim()
+            .unwrap()
+            .world
+            .body(h.state().sim().unwrap().bodies[followed].handle)
+            .unwrap()
+            .is_static()
+    );
+    click(&mut h, "Play");
+    h.state_mut().set_speed(4.0);
+    // The view eases towards what it follows; the car drives right, so the view keeps
+    // moving right (the terrain it followed before stands still).
+    h.run_steps(5);
+    let halfway = h.state().camera().centre.x;
+    h.run_steps(5);
+    assert!(h.state().is_running());
+    let moved = h.state().camera().centre.x - halfway;
+    let app = h.state();
+    let sim = app.sim().unwrap();
+    let chassis = sim
+        .bodies
+        .iter()
+        .find(|b| b.id.ends_with("/chassis"))
+        .unwrap();
+    let car = sim.world.body(chassis.handle).unwrap().centroid();
+    let view = app.camera().centre;
+    // Followed, the terrain drew the view down to its own centre (51 below the car, and
+    // 98 right in those frames, against 183).
+    assert!(
+        moved > 140.0 && (view.y - car.y).abs() < 25.0,
+        "the view moved {moved:.0} right in 5 frames, to {view:?}; the car is at {car:?}"
+    );
+}

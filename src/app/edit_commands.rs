@@ -136,6 +136,10 @@ impl RoboSimApp {
         Vec2::new(tools::snap(p.x, step), tools::snap(p.y, step))
     }
 
+    /// How near (screen points) a click of the joint tool must be to a body's centre or
+    /// vertex to land on it.
+    const JOINT_SNAP_POINTS: f64 = 6.0;
+
     /// Applies the current tool at world point `p` (the robot preview puts the robot's
     /// frame at the world origin, so world and robot coordinates agree).
     fn use_tool(&mut self, p: Vec2, now: f64) {
@@ -144,7 +148,14 @@ impl RoboSimApp {
         else {
             return;
         };
-        let p = self.snapped(p);
+        // A centre or a vertex within a few points, else the grid.
+        let radius = Self::JOINT_SNAP_POINTS / self.view.camera.zoom;
+        let p = self
+            .doc
+            .model()
+            .robot(&robot)
+            .and_then(|r| tools::joint_snap_point(self.doc.model(), r, p, radius))
+            .unwrap_or_else(|| self.snapped(p));
         let mut draft = self.doc.model().clone();
         match tools::add_joint(&mut draft, &robot, p) {
             Ok(j) => {

@@ -264,6 +264,35 @@ pub fn bodies_at(model: &Model, robot: &Robot, p: Vec2) -> Vec<String> {
         .collect()
 }
 
+/// The centre of mass or vertex of one of `robot`'s bodies nearest to `p` (robot
+/// coordinates) within `radius`, centres first: a wheel's axle lands on its centre, not a
+/// pixel off, when the joint tool is clicked near it.
+pub fn joint_snap_point(model: &Model, robot: &Robot, p: Vec2, radius: f64) -> Option<Vec2> {
+    let mut centres = Vec::new();
+    let mut vertices = Vec::new();
+    for b in &robot.bodies {
+        let Some(polygon) = model
+            .body(&b.placement.source)
+            .and_then(|d| outline_polygon(&d.vertices).ok())
+        else {
+            continue;
+        };
+        let pl = &b.placement;
+        let (s, c) = pl.orientation.sin_cos();
+        let place = |v: Vec2| Vec2::new(pl.x + c * v.x - s * v.y, pl.y + s * v.x + c * v.y);
+        centres.push(place(polygon.mass_properties().centroid));
+        vertices.extend(polygon.vertices().iter().map(|&v| place(v)));
+    }
+    let nearest = |points: &[Vec2]| {
+        points
+            .iter()
+            .copied()
+            .filter(|q| (q - p).norm() <= radius)
+            .min_by(|a, b| (a - p).norm().total_cmp(&(b - p).norm()))
+    };
+    nearest(&centres).or_else(|| nearest(&vertices))
+}
+
 /// Pins the two topmost bodies of robot `robot_name` that cover `p` (robot coordinates):
 /// the new joint's anchor is `p` relative to bodyA's placement (thesis §6.6).
 pub fn add_joint(model: &mut Model, robot_name: &str, p: Vec2) -> Result<JointDef, String> {
@@ -312,6 +341,42 @@ mod tests {
 
     fn square() -> Vec<[f64; 2]> {
         vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]
+    }
+
+    #[test]
+    fn the_joint_tool_snaps_to_a_centre_then_a_vertex_within_its_radius() {
+        let mut model = Model::default();
+        model.bodies.push(BodyDef {
+            name: "wheel".into(),
+            density: 1.0,
+            vertices: vec![[-10.0, -10.0], [10.0, -10.0], [10.0, 10.0], [-10.0, 10.0]],
+            ..Default::default()
+        });
+        let robot = Robot {
+            name: "r".into(),
+            bodies: vec![RobotBody {
+                placement: Placement {
+                    alias: "w".into(),
+                    source: "wheel".into(),
+                    x: 100.0,
+                    y: 50.0,
+                    orientation: std::f64::consts::FRAC_PI_4,
+                    ..Default::default()
+                },
+                motors: Vec::new(),
+            }],
+            ..Default::default()
+        };
+        let near = |x, y| joint_snap_point(&model, &robot, Vec2::new(x, y), 3.0);
+        assert_eq!(
+            near(101.0, 51.0),
+            Some(Vec2::new(100.0, 50.0)),
+            "the centre"
+        );
+        // The corner (10, 10) turned 45°: (0, 10√2) from the centre.
+        let corner = near(100.5, 50.0 + 14.0).unwrap();
+        assert!((corner - Vec2::new(100.0, 50.0 + 200f64.sqrt())).norm() < 1e-9);
+        assert_eq!(near(106.0, 50.0), None, "nothing within the radius");
     }
 
     #[test]

@@ -633,16 +633,19 @@ fn overlap_note(sim: &Simulation, overlaps: &[(usize, usize)]) -> String {
     )
 }
 
-/// The selected body's centroid, or the mean centroid of the moving bodies (those still
-/// inside the world bound).
+/// The selected body's centroid if it can move, or the mean centroid of the moving
+/// bodies (those inside the world bound).
 fn follow_point(
     sim: &Simulation,
     selected: Option<usize>,
     bound: Option<&WorldBound>,
 ) -> Option<Vec2> {
+    // A static body selected (terrain just drawn) does not move: the view follows what
+    // does.
     if let Some(body) = selected
         .and_then(|i| sim.bodies.get(i))
         .and_then(|b| sim.world.body(b.handle))
+        .filter(|b| !b.is_static())
     {
         return Some(body.centroid());
     }
