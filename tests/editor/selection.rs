@@ -232,8 +232,10 @@ fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
 }
 
 /// The rotate handle turns a body by the angle the pointer swept about its origin,
-/// however many moves the sweep takes (issue 64: each move added the whole angle since
-/// the press, so a 45° sweep in 4 moves turned 105.6°), and selects nothing on the way.
+/// however many moves the sweep takes and however long the pointer rests between them
+/// (issue 64: a frame at rest forgot the press, and the next move added the whole angle
+/// since the press again: a 45° sweep in 4 moves turned 105.6°), and keeps the
+/// selection.
 #[test]
 fn the_rotate_handle_turns_by_the_angle_swept() {
     let dir = scratch_db();
@@ -266,6 +268,8 @@ fn the_rotate_handle_turns_by_the_angle_swept() {
             h.event(egui::Event::PointerMoved(at(
                 sweep * k as f32 / moves as f32
             )));
+            h.run_steps(1);
+            // A frame with the pointer at rest between moves, as a real mouse gives.
             h.run_steps(1);
         }
         h.event(button(at(sweep), false));

@@ -597,8 +597,14 @@ fn turn(
     let body = sim.bodies.get(i).and_then(|b| sim.world.body(b.handle))?;
     let origin = body.origin();
     let start_id = egui::Id::unique(("turn start", i));
-    if !dragging {
+    // The angle and bearing at the press hold until the button is released: a frame in
+    // which the pointer rests is still the same drag (forgetting them there made the next
+    // move add the whole sweep since the press again).
+    if !ui.input(|i| i.pointer.primary_down()) {
         ui.ctx().data_mut(|d| d.remove::<(f64, f64)>(start_id));
+        return None;
+    }
+    if !dragging {
         return None;
     }
     let pressed = pressed?;
