@@ -935,7 +935,7 @@ fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() 
     h.run_steps(2);
     let pasted = scene(&h);
     assert_eq!(pasted.bodies.len(), count + 1, "{}", h.state().status());
-    assert_eq!(pasted.bodies[count].alias, "box 1 2");
+    assert_eq!(pasted.bodies[count].alias, "box 9");
     assert!(h.state().overlaps().is_empty(), "pasted in free space");
 
     // The handle above the selected box turns it: dragged from straight above the origin

@@ -346,6 +346,24 @@ pub fn unusable_bodies_question(model: &Model) -> Option<String> {
     ))
 }
 
+/// `name` if it is free, else the next free name in its count: a name ending in a
+/// number counts on from it ("box 5" → "box 6", "box 5 2" → "box 5 3"), another gets
+/// " 2", " 3", … (`unique`). Duplicates are named as a person would number them.
+pub fn next_in_count(taken: &[String], name: &str) -> String {
+    if !taken.iter().any(|t| t == name) {
+        return name.to_string();
+    }
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    let (stem, number) = name.split_at(name.len() - digits);
+    match number.parse::<u64>() {
+        Ok(n) if !stem.is_empty() && n < u64::MAX / 2 => (n + 1..)
+            .map(|k| format!("{stem}{k}"))
+            .find(|c| !taken.contains(c))
+            .expect("some number is free"),
+        _ => unique(taken, name),
+    }
+}
+
 /// `base`, or `base 2`, `base 3`, … whichever is not in `taken`.
 pub fn unique(taken: &[String], base: &str) -> String {
     if !taken.iter().any(|t| t == base) {

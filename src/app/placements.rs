@@ -3,7 +3,7 @@
 //! The canvas selects simulated bodies; an edit changes the placements behind them (a
 //! scene's body, a whole robot in a scene, a robot's body), each once.
 
-use super::{Copied, RoboSimApp, Selection, document::unique, placing};
+use super::{Copied, RoboSimApp, Selection, document::next_in_count, placing};
 use crate::model::{JointDef, Model, Robot, Scene, same_name};
 use crate::sim::PlacedBy;
 use pe::{Aabb, Vec2};
@@ -324,7 +324,7 @@ fn paste_into_robot(robot: &mut Robot, items: Vec<Copied>, joints: Vec<JointDef>
             .iter()
             .map(|b| b.placement.alias.clone())
             .collect();
-        let alias = unique(&aliases, &body.placement.alias);
+        let alias = next_in_count(&aliases, &body.placement.alias);
         renamed.push((body.placement.alias.clone(), alias.clone()));
         body.placement.alias = alias;
         body.placement.x += 20.0;
@@ -359,7 +359,7 @@ pub(super) fn put_in_scene(scene: &mut Scene, items: Vec<Copied>, delta: Vec2) -
             }
             Copied::SceneBody(mut b) => {
                 let aliases: Vec<String> = scene.bodies.iter().map(|b| b.alias.clone()).collect();
-                b.alias = unique(&aliases, &b.alias);
+                b.alias = next_in_count(&aliases, &b.alias);
                 (b.x, b.y) = (b.x + delta.x, b.y + delta.y);
                 scene.bodies.push(b);
                 placed.push(Owner::SceneBody(scene.bodies.len() - 1));

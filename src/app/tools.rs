@@ -185,7 +185,8 @@ pub const SNAP_STEPS: [Option<f64>; 5] = [None, Some(0.5), Some(1.0), Some(5.0),
 /// `v` rounded to the nearest multiple of `step` (unchanged when snapping is off).
 pub fn snap(v: f64, step: Option<f64>) -> f64 {
     match step {
-        Some(s) if s > 0.0 => (v / s).round() * s,
+        // `+ 0.0`: a point snapped to zero from below is 0, not -0 (written `-0`).
+        Some(s) if s > 0.0 => (v / s).round() * s + 0.0,
         _ => v,
     }
 }
@@ -230,6 +231,27 @@ pub fn add_vertex(vertices: &[[f64; 2]], p: [f64; 2]) -> Result<Vec<[f64; 2]>, S
         "a vertex at ({}, {}) would make the body non-convex{reason}; Shift+click adds it anyway, then Convex hull repairs the outline",
         p[0], p[1]
     ))
+}
+
+/// `vertices` with `p` put into the edge nearest to it, convex or not: what Shift+click
+/// adds (a dent the user means, to be repaired later) where `add_vertex` refuses.
+pub fn add_vertex_anyway(vertices: &[[f64; 2]], p: [f64; 2]) -> Vec<[f64; 2]> {
+    let point = Vec2::new(p[0], p[1]);
+    let n = vertices.len();
+    let nearest = (0..n).min_by(|&i, &k| {
+        let edge = |i: usize| {
+            let a = Vec2::new(vertices[i][0], vertices[i][1]);
+            let b = Vec2::new(vertices[(i + 1) % n][0], vertices[(i + 1) % n][1]);
+            distance_to_segment(point, a, b)
+        };
+        edge(i).total_cmp(&edge(k))
+    });
+    let mut v = vertices.to_vec();
+    match nearest {
+        Some(i) if n >= 3 => v.insert(i + 1, p),
+        _ => v.push(p),
+    }
+    v
 }
 
 fn distance_to_segment(p: Vec2, a: Vec2, b: Vec2) -> f64 {
@@ -377,6 +399,16 @@ mod tests {
         let corner = near(100.5, 50.0 + 14.0).unwrap();
         assert!((corner - Vec2::new(100.0, 50.0 + 200f64.sqrt())).norm() < 1e-9);
         assert_eq!(near(106.0, 50.0), None, "nothing within the radius");
+    }
+
+    #[test]
+    fn shift_click_puts_a_dent_into_the_nearest_edge_and_snaps_to_plus_zero() {
+        // Inside the square near its bottom edge (0,0)-(10,0): a dent there, not at the end.
+        let dented = add_vertex_anyway(&square(), [5.0, 1.0]);
+        assert_eq!(dented[1], [5.0, 1.0]);
+        assert_eq!(dented.len(), 5);
+        let zero = snap(-0.1, Some(0.5));
+        assert!(zero == 0.0 && zero.is_sign_positive(), "{zero:?}");
     }
 
     #[test]

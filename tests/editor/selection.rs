@@ -161,7 +161,8 @@ fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
     assert_eq!(pasted.bodies.len(), count + 3, "{}", h.state().status());
     let new: Vec<&Placement> = pasted.bodies[count..].iter().collect();
     let aliases: Vec<&str> = new.iter().map(|b| b.alias.as_str()).collect();
-    assert_eq!(aliases, ["box 2 2", "box 3 2", "box 4 2"]);
+    // Named on in the stack's count (boxes 1 to 8), not "box 2 2".
+    assert_eq!(aliases, ["box 9", "box 10", "box 11"]);
     // One offset for the group: the boxes stay stacked 30 apart.
     assert_eq!(new[0].x, new[1].x);
     assert_eq!(new[0].y - new[1].y, 30.0);
@@ -169,7 +170,7 @@ fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
     assert!(h.state().overlaps().is_empty(), "pasted in free space");
     assert_eq!(
         picked_ids(&h),
-        ["box 2 2", "box 3 2", "box 4 2"],
+        ["box 10", "box 11", "box 9"],
         "the pasted boxes are selected"
     );
     undo(&mut h);
@@ -211,7 +212,7 @@ fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
         .iter()
         .map(|b| b.placement.alias.as_str())
         .collect();
-    assert_eq!(aliases, ["h_0", "h_1", "h_2", "h_0 2", "h_1 2", "h_2 2"]);
+    assert_eq!(aliases, ["h_0", "h_1", "h_2", "h_3", "h_4", "h_5"]);
     let pins: Vec<(&str, &str)> = robot
         .joints
         .iter()
@@ -222,8 +223,8 @@ fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
         [
             ("h_0", "h_1"),
             ("h_1", "h_2"),
-            ("h_0 2", "h_1 2"),
-            ("h_1 2", "h_2 2")
+            ("h_3", "h_4"),
+            ("h_4", "h_5")
         ]
     );
     assert_eq!(robot.joints[2].anchor_ax, robot.joints[0].anchor_ax);

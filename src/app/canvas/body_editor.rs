@@ -163,14 +163,10 @@ impl CanvasView {
                     vertices: new,
                     key: "add vertex".into(),
                 },
-                Err(_) if anyway && !vertices.contains(&point) => {
-                    let mut new = vertices.to_vec();
-                    new.push(point);
-                    Command::SetVertices {
-                        vertices: new,
-                        key: "add vertex".into(),
-                    }
-                }
+                Err(_) if anyway && !vertices.contains(&point) => Command::SetVertices {
+                    vertices: tools::add_vertex_anyway(vertices, point),
+                    key: "add vertex".into(),
+                },
                 Err(why) => Command::Complain(why),
             });
         }
