@@ -78,7 +78,8 @@ pub struct RunArgs {
     /// file; with --gif and no --out, no trace is written.
     #[arg(long, value_name = "FILE")]
     pub gif: Option<PathBuf>,
-    /// Steps between the GIF's frames (default: a frame every 1/25 s of simulated time).
+    /// Steps between the GIF's frames (default: the whole number of steps nearest 1/25 s
+    /// of simulated time).
     #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..))]
     pub gif_every: Option<u64>,
 }

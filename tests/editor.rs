@@ -680,6 +680,23 @@ fn plots_show_one_unit_per_axis_with_readable_numbers_and_export_to_csv() {
         assert_eq!(row.split(',').count(), columns, "{row}");
         row.split(',').next().unwrap().parse::<f64>().unwrap();
     }
+    // The energies as the energy plot shows them (issue 64): potential and total since
+    // step 0, total = kinetic + potential change - kinetic at step 0.
+    assert!(
+        header.contains("potential energy since step 0")
+            && header.contains("total energy since step 0"),
+        "{header}"
+    );
+    let numbers =
+        |row: &str| -> Vec<f64> { row.split(',').take(4).map(|v| v.parse().unwrap()).collect() };
+    let first = numbers(rows[0]);
+    assert_eq!(
+        (first[2], first[3]),
+        (0.0, 0.0),
+        "nothing changed at step 0"
+    );
+    let last = numbers(rows[rows.len() - 1]);
+    assert!((last[3] - (last[1] + last[2] - first[1])).abs() <= 1e-9 * last[1].abs().max(1.0));
     assert!(
         h.state().status().contains("plots written"),
         "{}",

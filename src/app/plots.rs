@@ -298,7 +298,8 @@ pub fn to_csv(data: &PlotData) -> String {
     let mut header = vec![
         "time (s)".to_string(),
         format!("kinetic energy ({ENERGY})"),
-        format!("potential energy ({ENERGY})"),
+        format!("potential energy since step 0 ({ENERGY})"),
+        format!("total energy since step 0 ({ENERGY})"),
         format!("widest joint gap ({LENGTH})"),
     ];
     for name in ["x (px)", "y (px)", "angle (rad)", "vx (px/s)", "vy (px/s)"] {
@@ -324,18 +325,26 @@ pub fn to_csv(data: &PlotData) -> String {
             .join(","),
     );
     out.push('\n');
+    let start = data
+        .samples
+        .first()
+        .map_or((0.0, 0.0), |s| (s.kinetic, s.potential));
     for s in &data.samples {
-        out.push_str(&row(s, data.shown_state(s), data.motor_names.len()).join(","));
+        let row = row(s, start, data.shown_state(s), data.motor_names.len());
+        out.push_str(&row.join(","));
         out.push('\n');
     }
     out
 }
 
-fn row(s: &Sample, body: Option<BodyState>, motors: usize) -> Vec<String> {
+/// One sample as the plots show it: energies as in the energy plot (potential and total
+/// since step 0, whose energies are `start`), the shown body's state, the torques.
+fn row(s: &Sample, (k0, p0): (f64, f64), body: Option<BodyState>, motors: usize) -> Vec<String> {
     let mut row = vec![
         s.time.to_string(),
         s.kinetic.to_string(),
-        s.potential.to_string(),
+        (s.potential - p0).to_string(),
+        (s.kinetic + s.potential - k0 - p0).to_string(),
         s.max_joint_gap.to_string(),
     ];
     match body {
