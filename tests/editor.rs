@@ -1292,3 +1292,28 @@ fn follow_with_terrain_selected_follows_the_moving_robot() {
         "the view moved {moved:.0} right in 5 frames, to {view:?}; the car is at {car:?}"
     );
 }
+
+/// F1 opens the shortcut sheet and closes it again, as Esc does; Help has the user guide
+/// (issue 64).
+#[test]
+fn f1_and_esc_close_the_shortcut_sheet_and_help_opens_the_guide() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    let sheet_open = |h: &Harness<'_, RoboSimApp>| h.query_by_label("This list").is_some();
+    assert!(!sheet_open(&h));
+    for close in [Key::F1, Key::Escape] {
+        h.key_press(Key::F1);
+        h.run_steps(2);
+        assert!(sheet_open(&h), "F1 opens the sheet");
+        h.key_press(close);
+        h.run_steps(2);
+        assert!(!sheet_open(&h), "{close:?} closes it");
+    }
+    click(&mut h, "Help");
+    click(&mut h, "User guide");
+    h.run_steps(2);
+    assert!(
+        h.query_by_label_contains("RoboSim edits and simulates")
+            .is_some()
+    );
+}

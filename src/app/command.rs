@@ -134,6 +134,8 @@ pub enum Command {
     ToggleProblems,
     ShowShortcuts,
     ShowAbout,
+    /// The user guide, in a window.
+    ShowGuide,
 
     // Messages for the status bar.
     Inform(String),

@@ -122,6 +122,10 @@ fn question(dialog: &Dialog) -> (String, Vec<Answer>) {
 
 /// The shortcut sheet: every shortcut of `shortcuts::SHORTCUTS`, and the mouse.
 pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
+    if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
+        *open = false;
+        return;
+    }
     egui::Window::new("Keyboard shortcuts")
         .open(open)
         .resizable(false)
@@ -155,6 +159,40 @@ pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
                         ui.end_row();
                     }
                 });
+        });
+}
+
+/// The user guide (docs/user-guide.md, compiled in), as its text: always at hand, with
+/// no browser and no network.
+pub fn user_guide(ctx: &egui::Context, open: &mut bool) {
+    if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
+        *open = false;
+        return;
+    }
+    const GUIDE: &str = include_str!("../../docs/user-guide.md");
+    egui::Window::new("User guide")
+        .open(open)
+        .default_size([640.0, 520.0])
+        .show(ctx, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                // Arrows as the default fonts can draw them.
+                let arrows = [("←", "<-"), ("→", "->"), ("↑", "up"), ("↓", "down")];
+                for line in GUIDE.lines().filter(|l| !l.starts_with("![")) {
+                    let line = arrows
+                        .iter()
+                        .fold(line.to_string(), |l, (from, to)| l.replace(from, to));
+                    let line = line.as_str();
+                    match line.strip_prefix("## ").or_else(|| line.strip_prefix("# ")) {
+                        Some(heading) => {
+                            ui.add_space(6.0);
+                            ui.heading(heading);
+                        }
+                        None => {
+                            ui.label(line);
+                        }
+                    }
+                }
+            });
         });
 }
 

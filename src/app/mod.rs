@@ -106,6 +106,7 @@ pub struct RoboSimApp {
     show_problems: bool,
     show_shortcuts: bool,
     show_about: bool,
+    show_guide: bool,
     /// How the app asks for folders and file names.
     files: Box<dyn files::FileChooser>,
     copied: Option<placements::Clipboard>,
@@ -135,6 +136,7 @@ impl RoboSimApp {
             show_problems: false,
             show_shortcuts: false,
             show_about: false,
+            show_guide: false,
             files: Box::new(files::SystemDialogs),
             copied: None,
             close_confirmed: false,
@@ -374,8 +376,10 @@ impl RoboSimApp {
             C::SetDebug(debug) => self.view.debug = debug,
             C::Follow(body) => self.follow(body),
             C::ToggleProblems => self.show_problems = !self.show_problems,
-            C::ShowShortcuts => self.show_shortcuts = true,
+            // F1 (or the menu) opens the sheet and closes it again.
+            C::ShowShortcuts => self.show_shortcuts = !self.show_shortcuts,
             C::ShowAbout => self.show_about = true,
+            C::ShowGuide => self.show_guide = true,
             C::Inform(text) => self.inform(text),
             C::Complain(text) => self.complain(text),
             edit => self.apply_edit(edit, now),
@@ -584,6 +588,9 @@ impl RoboSimApp {
         }
         if self.show_shortcuts {
             dialogs::shortcut_sheet(ctx, &mut self.show_shortcuts);
+        }
+        if self.show_guide {
+            dialogs::user_guide(ctx, &mut self.show_guide);
         }
         if self.show_about {
             dialogs::about(ctx, &mut self.show_about);

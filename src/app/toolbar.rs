@@ -81,6 +81,15 @@ impl Toolbar {
                 ) {
                     out.push(Command::ShowShortcuts);
                 }
+                if entry(
+                    ui,
+                    true,
+                    "User guide",
+                    None,
+                    "How to draw, build, run and share",
+                ) {
+                    out.push(Command::ShowGuide);
+                }
                 if entry(ui, true, "About RoboSim", None, "Version and licence") {
                     out.push(Command::ShowAbout);
                 }
