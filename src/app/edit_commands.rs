@@ -86,12 +86,15 @@ impl RoboSimApp {
     fn undo(&mut self) {
         if self.doc.undo() {
             self.model_edited();
+            // What the undone edit said ("removed 5 placements") is no longer so.
+            self.inform("undone".into());
         }
     }
 
     fn redo(&mut self) {
         if self.doc.redo() {
             self.model_edited();
+            self.inform("redone".into());
         }
     }
 

@@ -288,8 +288,9 @@ impl RoboSimApp {
         match self.selection.clone() {
             Some(sel) if self.doc.has(&sel) => {
                 self.select(sel);
-                if !self.message.is_error {
-                    // What the edit said ("pinned a to b") outlives the rebuild it caused.
+                if !self.message.is_error && !message.is_error {
+                    // What the edit said ("pinned a to b") outlives the rebuild it caused; a
+                    // complaint the edit answered (a dent refused) does not.
                     self.message = message;
                 }
                 self.runner.running = false;
@@ -344,7 +345,13 @@ impl RoboSimApp {
             | C::Restore(..)
             | C::DiscardKeptWork(_) => self.apply_file_command(command, ctx, now),
             C::SetRunning(on) => self.runner.running = on,
-            C::TogglePlay => self.runner.running = !self.runner.running,
+            C::TogglePlay => {
+                self.runner.running = !self.runner.running;
+                // What the run said when it stopped ("paused: nothing moves") is stale now.
+                if self.runner.running && !self.message.is_error {
+                    self.inform(String::new());
+                }
+            }
             C::Step => {
                 self.runner.running = false;
                 let note = self.runner.step(self.followed);
@@ -353,6 +360,8 @@ impl RoboSimApp {
             C::Reset => {
                 self.runner.reset(self.followed);
                 self.view.fit();
+                // "left the scene", "paused": the run they spoke of is gone.
+                self.inform(String::new());
             }
             C::SetSpeed(speed) => self.runner.speed = speed,
             C::SetSolver(solver) => self.runner.set_solver(solver),

@@ -158,6 +158,18 @@ impl Runner {
             }
             Err(e) => {
                 self.sim = None;
+                // The preview's scene is an internal one: the message names what it shows.
+                let shown = match selection {
+                    Selection::Robot(name) => format!("robot \"{}\"", crate::db::clip(name)),
+                    Selection::Body(name) => format!("body \"{}\"", crate::db::clip(name)),
+                    Selection::Scene(_) => String::new(),
+                };
+                let internal = format!("scene \"{}\"", crate::db::clip(PREVIEW));
+                let e = if shown.is_empty() {
+                    e.to_string()
+                } else {
+                    e.to_string().replace(&internal, &shown)
+                };
                 Err(e.to_string())
             }
         };

@@ -284,3 +284,21 @@ fn the_rotate_handle_turns_by_the_angle_swept() {
         assert_eq!(picked_ids(&h), ["box 3"], "the sweep kept the selection");
     }
 }
+
+/// The status bar does not keep what stopped being true (issue 64): "removed 3
+/// placements" after Undo.
+#[test]
+fn undo_replaces_what_the_undone_edit_said() {
+    let dir = scratch_db();
+    let mut h = stack_at_step_0(dir.path());
+    pick_three(&mut h);
+    h.key_press(Key::Delete);
+    h.run_steps(2);
+    let said = h.state().status().to_string();
+    assert!(
+        said.contains("removed") || said.contains("deleted"),
+        "{said}"
+    );
+    undo(&mut h);
+    assert_eq!(h.state().status(), "undone");
+}
