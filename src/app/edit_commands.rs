@@ -39,6 +39,7 @@ impl RoboSimApp {
             Command::CopyPlacement => {
                 if let Some(clip) = self.copy_picked() {
                     let n = clip.items.len();
+                    self.clipboard_out = Some(clip.to_text());
                     self.copied = Some(clip);
                     self.inform(format!(
                         "copied {n} placement{}",
@@ -48,12 +49,17 @@ impl RoboSimApp {
             }
             Command::CutPlacement => {
                 if let Some(clip) = self.copy_picked() {
+                    self.clipboard_out = Some(clip.to_text());
                     self.copied = Some(clip);
                     self.remove_picked(now);
                 }
             }
             Command::PastePlacement => {
-                if let Some(clip) = self.copied.clone() {
+                // Placements from the system clipboard (copied here or in another
+                // window), else the ones copied here.
+                let from_text =
+                    (self.pasted.take()).and_then(|t| super::placements::Clipboard::from_text(&t));
+                if let Some(clip) = from_text.or_else(|| self.copied.clone()) {
                     self.paste_clipboard(clip, "paste", now);
                 }
             }

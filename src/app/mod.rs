@@ -110,6 +110,11 @@ pub struct RoboSimApp {
     /// How the app asks for folders and file names.
     files: Box<dyn files::FileChooser>,
     copied: Option<placements::Clipboard>,
+    /// Text for the system clipboard, put there at the end of the frame (Ctrl+C, X).
+    clipboard_out: Option<String>,
+    /// The text of this frame's paste event, if any: placements copied in this window or
+    /// another are pasted from it, others from `copied`.
+    pasted: Option<String>,
     /// The window may close: the user answered the unsaved-changes question.
     close_confirmed: bool,
     /// What an export finished on another thread (a PNG of the view, a GIF of the run)
@@ -139,6 +144,8 @@ impl RoboSimApp {
             show_guide: false,
             files: Box::new(files::SystemDialogs),
             copied: None,
+            clipboard_out: None,
+            pasted: None,
             close_confirmed: false,
             export_news: Default::default(),
         };
@@ -647,6 +654,16 @@ impl eframe::App for RoboSimApp {
         let typing = ctx.text_edit_focused();
         let (frame_seconds, now) = ui.input(|i| (i.stable_dt as f64, i.time));
         let tool_on = self.view.tool != tools::Tool::Select;
+        self.pasted = (!typing)
+            .then(|| {
+                ui.input(|i| {
+                    i.events.iter().find_map(|e| match e {
+                        egui::Event::Paste(text) => Some(text.clone()),
+                        _ => None,
+                    })
+                })
+            })
+            .flatten();
         let actions = ui.input_mut(|i| shortcuts::pressed(i, typing, tool_on));
         for action in actions {
             if let Some(command) = self.action(action) {
@@ -662,6 +679,9 @@ impl eframe::App for RoboSimApp {
         commands.extend(self.windows(&ctx));
         for command in commands {
             self.apply(command, &ctx, now);
+        }
+        if let Some(text) = self.clipboard_out.take() {
+            ctx.copy_text(text);
         }
         if self.runner.running || self.runner.grab.is_some() {
             ctx.request_repaint();

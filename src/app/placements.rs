@@ -27,6 +27,90 @@ pub struct Clipboard {
     pub joints: Vec<JointDef>,
 }
 
+/// The name the clipboard's record goes by in its text.
+const CLIPBOARD_RECORD: &str = "robosim clipboard";
+
+impl Clipboard {
+    /// The placements as the text of a robots.xml (robot bodies and their joints) or a
+    /// scenes.xml (robots and bodies placed in a scene), one record named
+    /// "robosim clipboard" carrying the box in attributes: what Ctrl+C puts on the
+    /// system clipboard, so that Ctrl+V works there and in another window of the app.
+    pub fn to_text(&self) -> String {
+        let b = self.bounds;
+        let extra: Vec<(String, String)> = [
+            ("minX", b.min.x),
+            ("minY", b.min.y),
+            ("maxX", b.max.x),
+            ("maxY", b.max.y),
+        ]
+        .iter()
+        .map(|(k, v)| (k.to_string(), crate::db::write::number(*v)))
+        .collect();
+        let robot_bodies: Vec<_> = self
+            .items
+            .iter()
+            .filter_map(|c| match c {
+                Copied::RobotBody(b) => Some(b.clone()),
+                _ => None,
+            })
+            .collect();
+        if !robot_bodies.is_empty() {
+            let robot = Robot {
+                name: CLIPBOARD_RECORD.into(),
+                bodies: robot_bodies,
+                joints: self.joints.clone(),
+                extra,
+                ..Default::default()
+            };
+            return crate::db::write::robots(&[robot]);
+        }
+        let mut scene = Scene {
+            name: CLIPBOARD_RECORD.into(),
+            extra,
+            ..Default::default()
+        };
+        for c in &self.items {
+            match c {
+                Copied::SceneRobot(r) => scene.robots.push(r.clone()),
+                Copied::SceneBody(b) => scene.bodies.push(b.clone()),
+                Copied::RobotBody(_) => {}
+            }
+        }
+        crate::db::write::scenes(&[scene])
+    }
+
+    /// The placements of a text `to_text` wrote (in this window or another); `None` for
+    /// any other text.
+    pub fn from_text(text: &str) -> Option<Self> {
+        let (robots, scenes) = crate::db::records_from_text(text)?;
+        let bounds_in = |extra: &[(String, String)]| {
+            let get = |key: &str| {
+                let value = extra.iter().find(|(k, _)| k == key)?;
+                value.1.trim().parse::<f64>().ok().filter(|v| v.is_finite())
+            };
+            Some(Aabb {
+                min: Vec2::new(get("minX")?, get("minY")?),
+                max: Vec2::new(get("maxX")?, get("maxY")?),
+            })
+        };
+        if let Some(r) = robots.into_iter().find(|r| r.name == CLIPBOARD_RECORD) {
+            return Some(Self {
+                bounds: bounds_in(&r.extra)?,
+                items: r.bodies.into_iter().map(Copied::RobotBody).collect(),
+                joints: r.joints,
+            });
+        }
+        let s = scenes.into_iter().find(|s| s.name == CLIPBOARD_RECORD)?;
+        let robots = s.robots.into_iter().map(Copied::SceneRobot);
+        let bodies = s.bodies.into_iter().map(Copied::SceneBody);
+        Some(Self {
+            bounds: bounds_in(&s.extra)?,
+            items: robots.chain(bodies).collect(),
+            joints: Vec::new(),
+        })
+    }
+}
+
 impl Copied {
     fn position(&self) -> Vec2 {
         match self {

@@ -925,3 +925,16 @@ impl Model {
         Ok(())
     }
 }
+
+/// The records of a robots.xml or scenes.xml text that read without an error, as the
+/// clipboard carries them between windows; `None` if the text is neither.
+pub fn records_from_text(
+    text: &str,
+) -> Option<(Vec<crate::model::Robot>, Vec<crate::model::Scene>)> {
+    let parsed = xml::parse(text, "clipboard").ok()?;
+    match &*parsed.root.name {
+        "robots" => Some((read::robots(&parsed.root, "clipboard").records, Vec::new())),
+        "scenes" => Some((Vec::new(), read::scenes(&parsed.root, "clipboard").records)),
+        _ => None,
+    }
+}

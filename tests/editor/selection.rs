@@ -302,3 +302,49 @@ fn undo_replaces_what_the_undone_edit_said() {
     undo(&mut h);
     assert_eq!(h.state().status(), "undone");
 }
+
+/// Ctrl+C puts the placements on the system clipboard as text, so that Ctrl+V pastes
+/// them whatever the clipboard held before, and in another window of the app (issue 64:
+/// Ctrl+V pasted nothing unless the clipboard already held text).
+#[test]
+fn copied_placements_go_on_the_system_clipboard_and_paste_in_another_window() {
+    let dir = scratch_db();
+    let mut h = stack_at_step_0(dir.path());
+    pick_three(&mut h);
+    // The key going down alone, so that the frame it is read in is the last one run.
+    h.event(egui::Event::Key {
+        key: Key::C,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: Modifiers::COMMAND,
+    });
+    h.run_steps(1);
+    let copied = h
+        .output()
+        .platform_output
+        .commands
+        .iter()
+        .find_map(|c| match c {
+            egui::OutputCommand::CopyText(text) => Some(text.clone()),
+            _ => None,
+        })
+        .expect("the placements' text on the clipboard");
+    assert!(
+        copied.contains("robosim clipboard") && copied.contains("box 3"),
+        "{copied}"
+    );
+
+    // Another window, on another copy of the database: the paste event carries the text.
+    let other_dir = scratch_db();
+    let mut other = stack_at_step_0(other_dir.path());
+    let count = stack(&other).bodies.len();
+    other.event(egui::Event::Paste(copied));
+    other.run_steps(2);
+    let pasted = stack(&other);
+    assert_eq!(pasted.bodies.len(), count + 3, "{}", other.state().status());
+    let new: Vec<&Placement> = pasted.bodies[count..].iter().collect();
+    // The group keeps its shape: stacked 30 apart.
+    assert_eq!(new[0].y - new[1].y, 30.0);
+    assert_eq!(new[1].y - new[2].y, 30.0);
+}
