@@ -1317,3 +1317,25 @@ fn f1_and_esc_close_the_shortcut_sheet_and_help_opens_the_guide() {
             .is_some()
     );
 }
+
+/// The body editor's view holds while an outline is drawn (issue 64: it refitted when the
+/// third vertex made a body, so the next click landed off target).
+#[test]
+fn the_body_editor_keeps_its_view_while_an_outline_is_drawn() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "body");
+    click(&mut h, "Clear and draw");
+    let mut views = Vec::new();
+    for (x, y) in [(-35.0, -15.0), (35.0, -15.0), (35.0, 15.0), (-35.0, 15.0)] {
+        click_world(&mut h, x, y, Modifiers::NONE);
+        let camera = h.state().camera();
+        views.push((camera.centre, camera.zoom));
+    }
+    let name = match h.state().selection() {
+        Some(Selection::Body(name)) => name.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 4);
+    assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
+}

@@ -294,6 +294,10 @@ impl RoboSimApp {
         let message = self.message.clone();
         match self.selection.clone() {
             Some(sel) if self.doc.has(&sel) => {
+                // The body editor keeps its view while an outline is drawn: a body of fewer
+                // than three vertices has no simulated body, and refitting when the third
+                // made one moved the next click off target.
+                let keep_view = had_bodies || matches!(sel, Selection::Body(_));
                 self.select(sel);
                 if !self.message.is_error && !message.is_error {
                     // What the edit said ("pinned a to b") outlives the rebuild it caused; a
@@ -302,7 +306,7 @@ impl RoboSimApp {
                 }
                 self.runner.running = false;
                 self.view.camera = camera;
-                self.view.fitted = fitted && had_bodies;
+                self.view.fitted = fitted && keep_view;
                 let count = self.sim().map_or(0, |s| s.bodies.len());
                 self.followed = followed.filter(|&i| i < count);
                 self.picked = picked.into_iter().filter(|&i| i < count).collect();
