@@ -1339,3 +1339,31 @@ fn the_body_editor_keeps_its_view_while_an_outline_is_drawn() {
     assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 4);
     assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
 }
+
+/// A robot's preview runs at the step of the scenes that use it, the step its motors'
+/// speeds are shown at; a body alone does not run (issue 64).
+#[test]
+fn a_robot_previews_at_its_scenes_step_and_a_body_alone_does_not_run() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    let model = h.state().model().clone();
+    let (scene_step, robot) = model
+        .scenes
+        .iter()
+        .find_map(|s| Some((s.timestep?, s.robots.first()?.source.clone())))
+        .expect("a scene with a step of its own and a robot");
+    h.state_mut().select(Selection::Robot(robot.clone()));
+    h.run_steps(2);
+    assert_eq!(h.state().sim().unwrap().dt, scene_step, "robot {robot}");
+    h.state_mut()
+        .select(Selection::Body(model.bodies[0].name.clone()));
+    h.run_steps(2);
+    h.key_press(Key::Space);
+    h.run_steps(3);
+    assert!(!h.state().is_running());
+    assert!(
+        h.state().status().contains("nothing to run"),
+        "{}",
+        h.state().status()
+    );
+}

@@ -356,6 +356,11 @@ impl RoboSimApp {
             | C::Restore(..)
             | C::DiscardKeptWork(_) => self.apply_file_command(command, ctx, now),
             C::SetRunning(on) => self.runner.running = on,
+            C::TogglePlay if matches!(self.selection, Some(Selection::Body(_))) => {
+                self.inform(
+                    "a body alone has nothing to run: place it in a scene or a robot".into(),
+                );
+            }
             C::TogglePlay => {
                 self.runner.running = !self.runner.running;
                 // What the run said when it stopped ("paused: nothing moves") is stale now.

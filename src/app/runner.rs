@@ -8,7 +8,7 @@ use super::canvas::Grab;
 use super::placing;
 use super::plot_data::PlotData;
 use super::world_bound::{self, WorldBound};
-use crate::model::{Model, Placement, Scene, SceneRobot};
+use crate::model::{Model, Placement, Scene, SceneRobot, same_name};
 use crate::sim::Simulation;
 use pe::{Aabb, ContactSolver};
 use std::collections::VecDeque;
@@ -384,6 +384,12 @@ pub fn preview(model: &Model, robot: Option<&str>, body: Option<&str>) -> Model 
         ..Scene::default()
     };
     if let Some(r) = robot {
+        // At the step of the scenes that use the robot, as its motors' speeds are shown.
+        scene.timestep = model
+            .scenes
+            .iter()
+            .find(|s| s.robots.iter().any(|p| same_name(&p.source, r)))
+            .and_then(|s| s.timestep);
         scene.robots.push(SceneRobot {
             source: r.to_string(),
             ..SceneRobot::default()
