@@ -271,20 +271,30 @@ impl RoboSimApp {
                 self.write_export(&path, svg.as_bytes(), "view");
             }
             ImageFormat::Png => {
-                // The integration reads the pixels after this frame and calls back.
-                let (rect, scale) = (self.view.rect, ctx.pixels_per_point());
-                let written = self.export_news.clone();
-                let repaint = ctx.clone();
-                ctx.request_screenshot(move |image| {
-                    let outcome = write_png(&image.region(&rect, Some(scale)), &path)
-                        .map(|p| format!("view written to {}", p.display()));
-                    if let Ok(mut slot) = written.lock() {
-                        *slot = Some(outcome);
-                    }
-                    repaint.request_repaint();
-                });
+                // Taken of the next frame, drawn without the editing hints.
+                self.view.png_pending = Some(path);
+                ctx.request_repaint();
             }
         }
+    }
+
+    /// At the end of the frame drawn for a PNG export: asks the integration for its
+    /// pixels, which it hands back after the frame.
+    pub(super) fn take_png(&mut self, ctx: &egui::Context) {
+        let Some(path) = self.view.png_pending.take() else {
+            return;
+        };
+        let (rect, scale) = (self.view.rect, ctx.pixels_per_point());
+        let written = self.export_news.clone();
+        let repaint = ctx.clone();
+        ctx.request_screenshot(move |image| {
+            let outcome = write_png(&image.region(&rect, Some(scale)), &path)
+                .map(|p| format!("view written to {}", p.display()));
+            if let Ok(mut slot) = written.lock() {
+                *slot = Some(outcome);
+            }
+            repaint.request_repaint();
+        });
     }
 
     /// Reports an export another thread finished since the last frame.

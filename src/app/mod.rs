@@ -684,6 +684,8 @@ impl eframe::App for RoboSimApp {
         self.run_note(note);
         self.autosave_tick(&ctx, now);
         self.export_news();
+        // A PNG export asked for last frame is drawn in this one, then taken.
+        let png_frame = self.view.png_pending.is_some();
         let mut commands = self.panels(ui);
         commands.extend(self.windows(&ctx));
         for command in commands {
@@ -691,6 +693,9 @@ impl eframe::App for RoboSimApp {
         }
         if let Some(text) = self.clipboard_out.take() {
             ctx.copy_text(text);
+        }
+        if png_frame {
+            self.take_png(&ctx);
         }
         if self.runner.running || self.runner.grab.is_some() {
             ctx.request_repaint();

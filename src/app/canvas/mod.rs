@@ -101,6 +101,9 @@ pub struct CanvasView {
     /// The rubber band being dragged out on empty canvas: where the drag started and
     /// where the pointer is (screen points).
     pub band: Option<(egui::Pos2, egui::Pos2)>,
+    /// The PNG export this frame is drawn for: the canvas as the scene, without the
+    /// editing hints written over it.
+    pub png_pending: Option<std::path::PathBuf>,
 }
 
 impl Default for CanvasView {
@@ -117,6 +120,7 @@ impl Default for CanvasView {
             band: None,
             shape: ShapeOptions::default(),
             drawing: None,
+            png_pending: None,
         }
     }
 }
@@ -496,7 +500,7 @@ impl CanvasView {
     }
 
     fn hints(&self, ui: &mut egui::Ui, painter: &egui::Painter, scene: Scene<'_>) {
-        if !scene.editing {
+        if !scene.editing || self.png_pending.is_some() {
             return;
         }
         let hint = match self.tool {
