@@ -631,6 +631,11 @@ fn the_view_comes_back_with_fit_and_reset_and_the_car_demo_stops_at_the_edge_of_
         on_canvas(&h, body_origin(&h, "floor")),
         "the scene is back in view"
     );
+    // And so is the car where it was stopped (issue 64: it ended out of view).
+    assert!(
+        on_canvas(&h, body_origin(&h, "chassis")),
+        "the stopped car is in view"
+    );
 }
 
 #[test]

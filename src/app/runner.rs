@@ -365,7 +365,7 @@ impl Runner {
                 }
                 note = Some(RunNote {
                     text,
-                    scene_to_show: everything.then_some(bound.scene),
+                    scene_to_show: everything.then(|| bound.scene_and_stopped(sim)),
                 });
             }
         }

@@ -82,6 +82,25 @@ impl WorldBound {
     }
 
     /// Whether every moving body has been stopped.
+    /// The scene's neighbourhood and the bodies stopped at the edge of the world: what
+    /// the view shows when nothing moves any more (the stopped robot in view, not only
+    /// the scene it left).
+    pub fn scene_and_stopped(&self, sim: &Simulation) -> Aabb {
+        let mut area = self.scene;
+        for (h, _, _) in &self.stopped {
+            for v in sim
+                .world
+                .body(*h)
+                .into_iter()
+                .flat_map(|b| b.world_vertices())
+            {
+                area.min = area.min.inf(&v);
+                area.max = area.max.sup(&v);
+            }
+        }
+        area
+    }
+
     pub fn all_stopped(&self, sim: &Simulation) -> bool {
         sim.world
             .bodies()
