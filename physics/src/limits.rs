@@ -15,10 +15,13 @@ pub const DENSITY: f64 = 1e12;
 pub const FRICTION: f64 = 1e6;
 /// Each component of gravity (length units / s²).
 pub const GRAVITY: f64 = 1e9;
-/// Motor torques, and the torque a body is given by hand.
+/// Motor torques.
 pub const TORQUE: f64 = 1e15;
-/// The force a body is given by hand (the magnitude of `Body::force`).
-pub const FORCE: f64 = 1e15;
+/// The force and the torque a body is given by hand (`Body::force`, `Body::torque`): far
+/// above what a mouse spring puts on the heaviest legal body (a density of 1e12 over
+/// 1e4 square units, pulled 100 units at 10 rad/s: 1e20), far below where a step
+/// overflows.
+pub const FORCE: f64 = 1e30;
 /// Body velocities (length units / s).
 pub const SPEED: f64 = 1e9;
 /// Body spins and joint motor speeds (radians / s): a body motor's fastest speed per step

@@ -170,3 +170,19 @@ fn settings_out_of_range_are_refused_by_name() {
         }
     }
 }
+
+/// What a mouse spring puts on the heaviest legal body is taken, not refused: the limit
+/// on a hand-applied force is far above it (a density of 1e12 pulled hard: 1e20).
+#[test]
+fn a_heavy_body_pulled_hard_by_hand_steps() {
+    for solver in ContactSolver::ALL {
+        let mut world = World::new(Vec2::new(0.0, 9.81));
+        world.settings.contact_solver = solver;
+        let square = ConvexPolygon::rectangle(100.0, 100.0).unwrap();
+        let heavy = world.add_body(BodyDef::new(square, 1e12)).unwrap();
+        let body = world.body_mut(heavy).unwrap();
+        body.apply_force_at(Vec2::new(1e20, 0.0), Vec2::new(0.0, 40.0));
+        world.try_step(H).unwrap();
+        assert!(world.body(heavy).unwrap().velocity.x > 0.0, "{solver:?}");
+    }
+}

@@ -742,7 +742,7 @@ impl World {
     /// Every body's numbers, as `body_mut` may have set them, within `crate::limits`: what
     /// `Body::new` checks of a new body, and the forces.
     fn check_bodies_given(&self) -> Result<(), StepError> {
-        use crate::limits::{ANGLE, COORDINATE, FORCE, FRICTION, SPEED, SPIN, TORQUE};
+        use crate::limits::{ANGLE, COORDINATE, FORCE, FRICTION, SPEED, SPIN};
         for (handle, b) in self.bodies() {
             let numbers = [
                 ("x", b.position.x, COORDINATE),
@@ -751,7 +751,7 @@ impl World {
                 ("speed", b.velocity.norm(), SPEED),
                 ("spin", b.angular_velocity, SPIN),
                 ("force", b.force.norm(), FORCE),
-                ("torque", b.torque, TORQUE),
+                ("torque", b.torque, FORCE),
                 ("friction", b.friction.unwrap_or(0.0), FRICTION),
             ];
             let beyond = crate::limits::first_beyond(numbers).or_else(|| {
