@@ -1372,3 +1372,43 @@ fn a_robot_previews_at_its_scenes_step_and_a_body_alone_does_not_run() {
         h.state().status()
     );
 }
+
+/// An edit a running scene cannot take up as it runs asks before it starts the run again
+/// at step 0 (issue 64); Cancel leaves the run and the model as they were.
+#[test]
+fn an_edit_that_must_restart_a_run_asks_first() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("stack of boxes").click();
+    h.run_steps(2);
+    click(&mut h, "Play");
+    h.run_steps(10);
+    click(&mut h, "Pause");
+    let before = h.state().model().clone();
+    let steps = h.state().sim().unwrap().step_count();
+    assert!(steps > 0);
+    // The scene's solver is not one a run takes up as it goes.
+    h.get_by_label_contains("This scene's own contact solver")
+        .click();
+    h.run_steps(2);
+    h.get_by_label("exact").click();
+    h.run_steps(4); // the question's window is laid out in a frame of its own first
+    assert!(h.query_by_label("Edit and restart").is_some(), "asked");
+    click(&mut h, "Cancel");
+    assert_eq!(*h.state().model(), before, "nothing changed");
+    assert_eq!(
+        h.state().sim().unwrap().step_count(),
+        steps,
+        "the run is as it was"
+    );
+    // Asked again and confirmed: made, and the scene is at step 0.
+    h.get_by_label_contains("This scene's own contact solver")
+        .click();
+    h.run_steps(2);
+    h.get_by_label("exact").click();
+    h.run_steps(4);
+    click(&mut h, "Edit and restart");
+    let scene = h.state().model().scene("stack of boxes").unwrap().clone();
+    assert_eq!(scene.solver.as_deref(), Some("exact"));
+    assert_eq!(h.state().sim().unwrap().step_count(), 0);
+}

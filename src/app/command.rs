@@ -55,6 +55,9 @@ pub enum Command {
     ExportGif,
     /// Take up (or forget) the unsaved work an earlier session kept for `folder`.
     Restore(Option<PathBuf>, Model),
+    /// An edit of a scene that has run, confirmed: made, and the scene built again at
+    /// step 0.
+    CommitRestarting(Box<Model>, String),
     DiscardKeptWork(Option<PathBuf>),
 
     // Edits of the model.

@@ -23,6 +23,9 @@ pub enum Dialog {
     /// Unsaved work from a session that did not end cleanly was found for the database in
     /// this folder.
     Restore(Option<PathBuf>, Model),
+    /// An edit (the model it makes, and its undo key) that a running scene cannot take
+    /// up as it runs: it starts the run again at step 0.
+    RestartForEdit(Box<Model>, String),
 }
 
 /// Shows `dialog`; once a button answers it, the commands that answer gives.
@@ -98,6 +101,19 @@ fn question(dialog: &Dialog) -> (String, Vec<Answer>) {
                     "Delete it and its placements",
                     "",
                     vec![Command::Delete(Delete::Cascade)],
+                ),
+                cancel,
+            ],
+        ),
+        Dialog::RestartForEdit(draft, key) => (
+            "This edit starts the run again at step 0 (gravity, friction, the step and joint \
+             motors change as it runs; other edits do not). Make it?"
+                .to_string(),
+            vec![
+                (
+                    "Edit and restart",
+                    "",
+                    vec![Command::CommitRestarting(draft.clone(), key.clone())],
                 ),
                 cancel,
             ],

@@ -321,6 +321,21 @@ impl RoboSimApp {
     /// Makes `draft` the model as one undoable edit (merged with the last if `key` is the
     /// same field soon after) and rebuilds what the canvas shows.
     fn commit(&mut self, draft: Model, key: &str, now: f64) {
+        // An edit a scene that has run cannot take up as it runs is asked about first.
+        let has_run = matches!(self.selection, Some(Selection::Scene(_)))
+            && self.sim().is_some_and(|s| s.step_count() > 0);
+        if has_run
+            && draft != *self.doc.model()
+            && !self.sim().is_some_and(|s| s.can_follow_live_edit(&draft))
+        {
+            if self.dialog.is_none() {
+                self.dialog = Some(dialogs::Dialog::RestartForEdit(
+                    Box::new(draft),
+                    key.to_string(),
+                ));
+            }
+            return;
+        }
         if self.doc.commit(draft, key, now) {
             self.model_edited();
         }
@@ -356,6 +371,11 @@ impl RoboSimApp {
             | C::Restore(..)
             | C::DiscardKeptWork(_) => self.apply_file_command(command, ctx, now),
             C::SetRunning(on) => self.runner.running = on,
+            C::CommitRestarting(draft, key) => {
+                if self.doc.commit(*draft, &key, now) {
+                    self.model_changed();
+                }
+            }
             C::TogglePlay if matches!(self.selection, Some(Selection::Body(_))) => {
                 self.inform(
                     "a body alone has nothing to run: place it in a scene or a robot".into(),

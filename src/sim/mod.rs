@@ -331,6 +331,35 @@ impl Simulation {
     /// else differs or a new number is one the scene may not have: then it is to be
     /// built again.
     pub fn follow_live_edit(&mut self, model: &Model) -> bool {
+        let Some(motors) = self.live_edit(model) else {
+            return false;
+        };
+        let scene = model.scene(&self.scene_name).expect("checked by live_edit");
+        let dt = scene.timestep();
+        self.world.gravity = Vec2::new(0.0, scene.gravitation);
+        self.world.friction = scene.friction;
+        self.dt = dt;
+        for (handle, m) in motors {
+            if let Some(motor) = self.world.joint_motor_mut(handle) {
+                motor.target_speed = pe_joint_speed(m.angular, dt);
+                motor.max_torque = m.max_torque;
+            }
+            if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
+                j.motor_window = Some((m.time0, m.time1, m.angular));
+            }
+        }
+        self.model = model.clone();
+        true
+    }
+
+    /// Whether `follow_live_edit` would take `model` up as the scene runs.
+    pub fn can_follow_live_edit(&self, model: &Model) -> bool {
+        self.live_edit(model).is_some()
+    }
+
+    /// The joint motors of `model`, by joint, if every other difference from the model
+    /// the scene was built from is one it can follow as it runs (see `follow_live_edit`).
+    fn live_edit(&self, model: &Model) -> Option<Vec<(JointHandle, crate::model::JointMotorDef)>> {
         // Both models with what may change live set aside must be equal.
         let set_aside = |m: &Model| {
             let mut m = m.clone();
@@ -348,15 +377,12 @@ impl Simulation {
             }
             m
         };
-        let Some(scene) = model.scene(&self.scene_name) else {
-            return false;
-        };
-        let dt = scene.timestep();
+        let scene = model.scene(&self.scene_name)?;
         if set_aside(model) != set_aside(&self.model)
             || !db::scene_number_problems(scene).is_empty()
-            || db::timestep_problem(dt).is_some()
+            || db::timestep_problem(scene.timestep()).is_some()
         {
-            return false;
+            return None;
         }
         let mut motors = Vec::new();
         for j in &self.joints {
@@ -365,25 +391,12 @@ impl Simulation {
             let def = robot.and_then(|robot| robot.joints.get(k)?.motor.as_ref());
             if let Some(m) = def {
                 if !db::joint_motor_problems(m).is_empty() {
-                    return false;
+                    return None;
                 }
                 motors.push((j.handle, m.clone()));
             }
         }
-        self.world.gravity = Vec2::new(0.0, scene.gravitation);
-        self.world.friction = scene.friction;
-        self.dt = dt;
-        for (handle, m) in motors {
-            if let Some(motor) = self.world.joint_motor_mut(handle) {
-                motor.target_speed = pe_joint_speed(m.angular, dt);
-                motor.max_torque = m.max_torque;
-            }
-            if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
-                j.motor_window = Some((m.time0, m.time1, m.angular));
-            }
-        }
-        self.model = model.clone();
-        true
+        Some(motors)
     }
 
     /// Solves contacts with `solver` from the next step on, and after `reset`.
