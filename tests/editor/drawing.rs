@@ -1,7 +1,7 @@
 //! The drawing tools: a box or a regular polygon dragged out on the canvas becomes a new
 //! body definition placed where it was drawn, in a scene or a robot, as one undo step.
 
-use super::{drag_world, harness, open_at_step_0, scratch_db};
+use super::{click, click_world, drag_world, harness, new_item, open_at_step_0, scratch_db};
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -119,4 +119,25 @@ fn a_polygon_dragged_into_a_robot_is_a_regular_body_of_that_radius_in_the_robot(
     );
     undo(&mut h);
     assert_eq!(*h.state().model(), before);
+}
+
+/// third vertex made a body, so the next click landed off target).
+#[test]
+fn the_body_editor_keeps_its_view_while_an_outline_is_drawn() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "body");
+    click(&mut h, "Clear and draw");
+    let mut views = Vec::new();
+    for (x, y) in [(-35.0, -15.0), (35.0, -15.0), (35.0, 15.0), (-35.0, 15.0)] {
+        click_world(&mut h, x, y, Modifiers::NONE);
+        let camera = h.state().camera();
+        views.push((camera.centre, camera.zoom));
+    }
+    let name = match h.state().selection() {
+        Some(Selection::Body(name)) => name.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 4);
+    assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
 }
