@@ -64,7 +64,8 @@ fn material(ui: &mut Ui, body: &mut BodyDef, edit: &mut Edit) {
 }
 
 fn vertex_list(ui: &mut Ui, body: &mut BodyDef, edit: &mut Edit) {
-    ui.label("vertices (relative to the body's origin)");
+    ui.label("vertices (relative to the body's origin)")
+        .on_hover_text("The outline, in order; drag them on the canvas or type them here");
     let mut remove = None;
     egui::Grid::new("vertices").num_columns(3).show(ui, |ui| {
         for (i, v) in body.vertices.iter_mut().enumerate() {

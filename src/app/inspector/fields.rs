@@ -58,7 +58,9 @@ impl MotorUnits {
 /// The name, applied on Enter or when the field loses focus.
 pub fn name_field(ui: &mut Ui, current: &str, buffer: &mut String) -> Option<String> {
     ui.horizontal(|ui| {
-        let label = ui.label("name");
+        let label = ui
+            .label("name")
+            .on_hover_text("What the files and the other records call it; unique among its kind");
         let response = ui
             .text_edit_singleline(buffer)
             .labelled_by(label.id)
@@ -81,14 +83,14 @@ pub fn placement_fields(
         .num_columns(2)
         .show(ui, |ui| {
             if aliased {
-                ui.label("alias");
+                ui.label("alias").on_hover_text("This placement's own name, unique where it is placed; traces and joints use it");
                 edit.touched(
                     format!("{key} alias"),
                     ui.text_edit_singleline(&mut p.alias).changed(),
                 );
                 ui.end_row();
             }
-            ui.label("source");
+            ui.label("source").on_hover_text("The body definition or robot this places");
             egui::ComboBox::from_id_salt(("source", key))
                 .selected_text(p.source.trim())
                 .show_ui(ui, |ui| {
@@ -100,7 +102,7 @@ pub fn placement_fields(
                     }
                 });
             ui.end_row();
-            ui.label("x, y");
+            ui.label("x, y").on_hover_text("Where the placed origin is, in the parent's units (y down)");
             ui.horizontal(|ui| {
                 edit.touched(
                     format!("{key} x"),
@@ -112,7 +114,7 @@ pub fn placement_fields(
                 );
             });
             ui.end_row();
-            ui.label("orientation");
+            ui.label("orientation").on_hover_text("Its turn about the origin, in radians (positive: clockwise on screen)");
             edit.touched(
                 format!("{key} o"),
                 ui.add(
@@ -136,7 +138,9 @@ pub fn body_motor_fields(
     egui::Grid::new(("motor", key))
         .num_columns(2)
         .show(ui, |ui| {
-            ui.label("steps");
+            ui.label("steps").on_hover_text(
+                "The motor runs from the first step up to, not including, the second",
+            );
             ui.horizontal(|ui| {
                 edit.touched(
                     format!("{key} t0"),
@@ -159,7 +163,8 @@ pub fn body_motor_fields(
                 ui.label(turn_arrow(m.angular, "", ""));
             });
             ui.end_row();
-            ui.label("torque");
+            ui.label("torque")
+                .on_hover_text("The torque it starts with and the most it ramps up to");
             ui.horizontal(|ui| {
                 edit.touched(
                     format!("{key} ts"),
@@ -238,14 +243,14 @@ pub fn joint_fields(
                 );
             });
             ui.end_row();
-            ui.label("collide");
+            ui.label("collide").on_hover_text("Whether the two pinned bodies also collide with each other");
             edit.touched(
                 format!("{key} collide"),
                 ui.checkbox(&mut j.collide, "the two bodies collide")
                     .changed(),
             );
             ui.end_row();
-            ui.label("motor");
+            ui.label("motor").on_hover_text("A joint motor: turns body B against body A");
             let mut has = j.motor.is_some();
             if ui
                 .checkbox(&mut has, "joint motor")
@@ -265,7 +270,7 @@ pub fn joint_fields(
             }
             ui.end_row();
             if let Some(m) = j.motor.as_mut() {
-                ui.label("steps");
+                ui.label("steps").on_hover_text("The motor runs from the first step up to, not including, the second");
                 ui.horizontal(|ui| {
                     edit.touched(
                         format!("{key} mt0"),
@@ -289,7 +294,7 @@ pub fn joint_fields(
                     ui.label(turn_arrow(m.angular, &j.body_b, &j.body_a));
                 });
                 ui.end_row();
-                ui.label("max torque");
+                ui.label("max torque").on_hover_text("The most torque the motor applies, on both bodies");
                 edit.touched(
                     format!("{key} mm"),
                     ui.add(

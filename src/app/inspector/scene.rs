@@ -74,7 +74,9 @@ fn settings(ui: &mut Ui, scene: &mut Scene, edit: &mut Edit) {
                 edit.touched("h".into(), true);
             }
             ui.end_row();
-            ui.label("solver");
+            ui.label("solver").on_hover_text(
+                "How this scene's contacts are solved (auto suits almost every scene)",
+            );
             let current = scene
                 .solver
                 .clone()
