@@ -8,10 +8,10 @@
 
 use super::bounce::{KeptVelocities, bounce_share, gains_energy, mix_velocities};
 use super::contact::Contact;
-use super::exact::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+use super::exact::system::{DenseRowsLcp, Row, RowKind, VelocityTargets, velocity_rows};
 use super::island::{IslandGrouping, island_ranges};
 use super::joint::JointConstraint;
-use super::lcp::{FrictionBound, LcpProblem, LcpSolver, REGULARISATION};
+use super::lcp::REGULARISATION;
 use super::{BodiesAndMoving, SolverBody};
 
 /// Whether the bodies' velocities already hold the step's forces (`exact`: a contact's
@@ -53,14 +53,9 @@ pub(crate) struct ImpactPass {
     island_joints: Vec<JointConstraint>,
     /// One pair's rows and their LCP.
     rows: Vec<Row>,
-    a: Vec<f64>,
-    b: Vec<f64>,
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    friction_index: Vec<Option<FrictionBound>>,
+    dense: DenseRowsLcp,
     x: Vec<f64>,
     x_full: Vec<f64>,
-    lcp: LcpSolver,
     /// A bouncing pair's bodies' velocities before it, after it, and after the same solve
     /// without a bounce (`solver::bounce`).
     before_bounce: KeptVelocities,
@@ -357,27 +352,7 @@ impl ImpactPass {
                 row.b = 0.0;
             }
         }
-        assemble(&self.rows, bodies, &mut self.a);
-        self.b.clear();
-        self.lo.clear();
-        self.hi.clear();
-        self.friction_index.clear();
-        for r in &self.rows {
-            self.b.push(r.b);
-            self.lo.push(r.lo);
-            self.hi.push(r.hi);
-            self.friction_index.push(r.friction_of);
-        }
-        let problem = LcpProblem {
-            n: self.rows.len(),
-            a: &self.a,
-            b: &self.b,
-            lo: &self.lo,
-            hi: &self.hi,
-            friction_index: Some(&self.friction_index),
-            regularisation: REGULARISATION,
-        };
-        self.lcp.solve_guessing(&problem, &[], &mut self.x);
+        (self.dense).solve(&self.rows, bodies, REGULARISATION, &[], &mut self.x);
     }
 }
 

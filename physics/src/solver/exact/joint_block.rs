@@ -5,11 +5,11 @@
 //! positions.
 
 use super::pin_island::{PinIsland, displace_island};
-use super::system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+use super::system::{DenseRowsLcp, Row, RowKind, VelocityTargets, velocity_rows};
 use crate::math::{Vec2, clamp};
 use crate::solver::island::{IslandGrouping, island_ranges};
 use crate::solver::joint::{JointConstraint, JointIterations, gap_target, own_block, solve_2x2};
-use crate::solver::lcp::{LcpMethod, LcpProblem, LcpSolver, REGULARISATION};
+use crate::solver::lcp::{LcpMethod, REGULARISATION};
 use crate::solver::{BodiesAndMoving, SolverBody};
 
 /// Islands with at most this many joints are solved by one direct (Cholesky) solve per
@@ -318,12 +318,8 @@ impl JointBlockSolver {
 #[derive(Debug, Clone, Default)]
 struct MotorSpeeds {
     rows: Vec<Row>,
-    a: Vec<f64>,
-    b: Vec<f64>,
-    lo: Vec<f64>,
-    hi: Vec<f64>,
+    dense: DenseRowsLcp,
     x: Vec<f64>,
-    lcp: LcpSolver,
 }
 
 impl MotorSpeeds {
@@ -345,25 +341,11 @@ impl MotorSpeeds {
                 _ => {}
             }
         }
-        assemble(&self.rows, bodies, &mut self.a);
-        self.b.clear();
-        self.lo.clear();
-        self.hi.clear();
-        for r in &self.rows {
-            self.b.push(r.b);
-            self.lo.push(r.lo.min(0.0));
-            self.hi.push(r.hi.max(0.0));
+        for row in self.rows.iter_mut() {
+            // Bounds that hold zero: a motor whose torque is spent is held where it is.
+            (row.lo, row.hi) = (row.lo.min(0.0), row.hi.max(0.0));
         }
-        let problem = LcpProblem {
-            n: self.rows.len(),
-            a: &self.a,
-            b: &self.b,
-            lo: &self.lo,
-            hi: &self.hi,
-            friction_index: None,
-            regularisation: REGULARISATION,
-        };
-        let stats = self.lcp.solve(&problem, &mut self.x);
+        let stats = (self.dense).solve(&self.rows, bodies, REGULARISATION, &[], &mut self.x);
         if stats.method == LcpMethod::Rejected || !self.x.iter().all(|x| x.is_finite()) {
             return;
         }

@@ -16,11 +16,11 @@ use super::contact::{Contact, ContactMemory};
 use super::impacts::{ImpactPass, Kick};
 use super::island::{IslandGrouping, island_ranges};
 use super::joint::JointConstraint;
-use super::lcp::{FrictionBound, LcpMethod, LcpProblem, LcpSolver, LcpStats, REGULARISATION};
+use super::lcp::{LcpMethod, LcpStats, REGULARISATION};
 use super::report::{IslandMethod, IslandReport};
 use super::{BodiesAndMoving, SolverBody};
 use crate::math::clamp;
-use system::{Row, RowKind, VelocityTargets, assemble, velocity_rows};
+use system::{DenseRowsLcp, Row, RowKind, VelocityTargets, velocity_rows};
 
 /// Islands with more rows than this are solved by projected Gauss–Seidel instead of the
 /// dense pivoting method, whose cost grows as n³. Measured by `examples/dense_threshold.rs`
@@ -66,13 +66,10 @@ pub(crate) struct SimultaneousSolver {
     island_joints: Vec<JointConstraint>,
     joint_slots: Vec<u32>,
     rows: Vec<Row>,
-    a: Vec<f64>,
+    dense: DenseRowsLcp,
+    /// Each row's velocity target less its velocity, for the row-by-row Gauss–Seidel.
     b: Vec<f64>,
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    friction_index: Vec<Option<FrictionBound>>,
     x: Vec<f64>,
-    lcp: LcpSolver,
     pub reports: Vec<IslandReport>,
     /// The bodies of the islands that went over the pivot budget in the last solve.
     pub over_budget_bodies: Vec<u32>,
@@ -343,27 +340,8 @@ impl SimultaneousSolver {
 
     /// The boxed LCP of the rows, assembled densely and solved by pivoting, into `x`.
     fn solve_rows_dense(&mut self, bodies: &[SolverBody]) -> LcpStats {
-        assemble(&self.rows, bodies, &mut self.a);
-        self.b.clear();
-        self.lo.clear();
-        self.hi.clear();
-        self.friction_index.clear();
-        for r in &self.rows {
-            self.b.push(r.b);
-            self.lo.push(r.lo);
-            self.hi.push(r.hi);
-            self.friction_index.push(r.friction_of);
-        }
-        let problem = LcpProblem {
-            n: self.rows.len(),
-            a: &self.a,
-            b: &self.b,
-            lo: &self.lo,
-            hi: &self.hi,
-            friction_index: Some(&self.friction_index),
-            regularisation: self.regularisation,
-        };
-        self.lcp.solve_guessing(&problem, &self.guess, &mut self.x)
+        let regularisation = self.regularisation;
+        (self.dense).solve(&self.rows, bodies, regularisation, &self.guess, &mut self.x)
     }
 
     /// Projected Gauss–Seidel on the rows themselves, for islands too big for a dense

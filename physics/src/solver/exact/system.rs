@@ -8,7 +8,7 @@ use crate::math::{Vec2, cross};
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
 use crate::solver::joint::JointConstraint;
-use crate::solver::lcp::FrictionBound;
+use crate::solver::lcp::{FrictionBound, LcpProblem, LcpSolver, LcpStats};
 
 /// One body's part of a row: the row's velocity is `linear·v + angular·ω` summed over both.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -221,6 +221,54 @@ pub(crate) fn velocity_rows(
             row.b = row.velocity(bodies) - m.target_speed;
             rows.push(row);
         }
+    }
+}
+
+/// A boxed LCP assembled densely from rows (`assemble`), with its buffers and solver
+/// kept from solve to solve: the islands' LCPs, the impact pass and the motors' hold
+/// each solve their rows through one.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct DenseRowsLcp {
+    a: Vec<f64>,
+    b: Vec<f64>,
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    friction_index: Vec<Option<FrictionBound>>,
+    lcp: LcpSolver,
+}
+
+impl DenseRowsLcp {
+    /// The impulses of `rows` at `bodies` into `x`, the friction rows' first bounds taken
+    /// from `guess` (empty: from zero).
+    pub(crate) fn solve(
+        &mut self,
+        rows: &[Row],
+        bodies: &[SolverBody],
+        regularisation: f64,
+        guess: &[f64],
+        x: &mut Vec<f64>,
+    ) -> LcpStats {
+        assemble(rows, bodies, &mut self.a);
+        self.b.clear();
+        self.lo.clear();
+        self.hi.clear();
+        self.friction_index.clear();
+        for r in rows {
+            self.b.push(r.b);
+            self.lo.push(r.lo);
+            self.hi.push(r.hi);
+            self.friction_index.push(r.friction_of);
+        }
+        let problem = LcpProblem {
+            n: rows.len(),
+            a: &self.a,
+            b: &self.b,
+            lo: &self.lo,
+            hi: &self.hi,
+            friction_index: Some(&self.friction_index),
+            regularisation,
+        };
+        self.lcp.solve_guessing(&problem, guess, x)
     }
 }
 
