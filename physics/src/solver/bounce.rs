@@ -63,6 +63,76 @@ impl KeptVelocities {
     }
 }
 
+/// What holding a bounce to the energy brought needs: the velocities of the solve's
+/// bodies before it, after it and after the same solve without a bounce, and the
+/// bouncing solve's impulses. The exact solver's islands and the impact pass's pairs go
+/// through it alike: `before`, the bouncing solve, `bounced`; if that gained energy,
+/// `undo_bounce`, the solve without a bounce, `hold`.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct BounceGuard {
+    before: KeptVelocities,
+    full: KeptVelocities,
+    inelastic: KeptVelocities,
+    x_full: Vec<f64>,
+}
+
+impl BounceGuard {
+    /// Keeps the velocities of the bodies at `slots` before the bouncing solve; their
+    /// kinetic energy, what the bodies brought.
+    pub(crate) fn before(
+        &mut self,
+        bodies: &[SolverBody],
+        slots: impl Iterator<Item = u32>,
+    ) -> f64 {
+        self.before.keep(bodies, slots);
+        self.before.kinetic_energy(bodies)
+    }
+
+    /// After the bouncing solve: keeps its velocities; their kinetic energy.
+    pub(crate) fn bounced(&mut self, bodies: &[SolverBody]) -> f64 {
+        self.full.keep_like(&self.before, bodies);
+        self.full.kinetic_energy(bodies)
+    }
+
+    /// The bodies as they were before the bouncing solve.
+    pub(crate) fn restore_before(&self, bodies: &mut [SolverBody]) {
+        self.before.restore(bodies);
+    }
+
+    /// Keeps the bouncing solve's impulses `x` and puts the bodies back as they were
+    /// before it, for the same solve without a bounce.
+    pub(crate) fn undo_bounce(&mut self, bodies: &mut [SolverBody], x: &[f64]) {
+        self.x_full.clear();
+        self.x_full.extend_from_slice(x);
+        self.before.restore(bodies);
+    }
+
+    /// After the solve without a bounce, whose impulses are `x`: the bodies and `x`
+    /// become that answer plus the largest share of the bounce that keeps the energy
+    /// within what was `brought` (or what the answer without a bounce leaves, where
+    /// motors work), or the whole bounce where that is within it.
+    pub(crate) fn hold(
+        &mut self,
+        bodies: &mut [SolverBody],
+        brought: f64,
+        bounced: f64,
+        x: &mut [f64],
+    ) {
+        self.inelastic.keep_like(&self.before, bodies);
+        let allowed = brought.max(self.inelastic.kinetic_energy(bodies));
+        if !gains_energy(allowed, bounced) {
+            self.full.restore(bodies);
+            x.copy_from_slice(&self.x_full);
+            return;
+        }
+        let s = bounce_share(&self.inelastic, &self.full, bodies, allowed);
+        mix_velocities(&self.inelastic, &self.full, s, bodies);
+        for (x, &full) in x.iter_mut().zip(&self.x_full) {
+            *x += (full - *x) * s;
+        }
+    }
+}
+
 /// The largest share s in [0, 1] of the way from `inelastic` to `full` (the same slots)
 /// at which the bodies have at most `allowed` kinetic energy, given that `inelastic` has
 /// no more than that. The energy along the way is a convex quadratic in s.

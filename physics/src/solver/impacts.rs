@@ -6,7 +6,7 @@
 //! the island's LCP (`on_island`); the soft step on every island before its substeps
 //! (`on_every_island`). Each pair's bounce adds no energy (`solver::bounce`).
 
-use super::bounce::{KeptVelocities, bounce_share, gains_energy, mix_velocities};
+use super::bounce::{BounceGuard, gains_energy};
 use super::contact::Contact;
 use super::exact::system::{DenseRowsLcp, Row, RowKind, VelocityTargets, velocity_rows};
 use super::island::{IslandGrouping, island_ranges};
@@ -55,12 +55,9 @@ pub(crate) struct ImpactPass {
     rows: Vec<Row>,
     dense: DenseRowsLcp,
     x: Vec<f64>,
-    x_full: Vec<f64>,
     /// A bouncing pair's bodies' velocities before it, after it, and after the same solve
     /// without a bounce (`solver::bounce`).
-    before_bounce: KeptVelocities,
-    full_bounce: KeptVelocities,
-    inelastic: KeptVelocities,
+    bounce: BounceGuard,
 }
 
 impl ImpactPass {
@@ -278,39 +275,25 @@ impl ImpactPass {
         let (start, end) = self.pair_spans[p];
         self.solve_impact_rows(bodies, targets);
         let ends = self.rows.iter().flat_map(|r| r.ends.iter().map(|e| e.body));
-        self.before_bounce.keep(bodies, ends);
-        let brought = self.before_bounce.kinetic_energy(bodies);
+        let brought = self.bounce.before(bodies, ends);
         for (row, &x) in self.rows.iter().zip(&self.x) {
             row.apply(bodies, x);
         }
-        self.full_bounce.keep_like(&self.before_bounce, bodies);
-        let bounced = self.full_bounce.kinetic_energy(bodies);
+        let bounced = self.bounce.bounced(bodies);
         if !bounced.is_finite() {
-            self.before_bounce.restore(bodies);
+            self.bounce.restore_before(bodies);
             return false;
         }
         if gains_energy(brought, bounced) {
             // A face's two points, each reflecting its own approach, or a pair whose rows
             // contradict its pins (two pinned bodies that overlap and may collide): the
             // bounce is held to what the pair brought (`solver::bounce`).
-            self.x_full.clear();
-            self.x_full.extend_from_slice(&self.x);
-            self.before_bounce.restore(bodies);
-            let inelastic = VelocityTargets {
-                bounce_below: f64::INFINITY,
-                ..*targets
-            };
-            self.solve_impact_rows(bodies, &inelastic);
+            self.bounce.undo_bounce(bodies, &self.x);
+            self.solve_impact_rows(bodies, &targets.without_bounce());
             for (row, &x) in self.rows.iter().zip(&self.x) {
                 row.apply(bodies, x);
             }
-            self.inelastic.keep_like(&self.before_bounce, bodies);
-            let allowed = brought.max(self.inelastic.kinetic_energy(bodies));
-            let s = bounce_share(&self.inelastic, &self.full_bounce, bodies, allowed);
-            mix_velocities(&self.inelastic, &self.full_bounce, s, bodies);
-            for (x, &full) in self.x.iter_mut().zip(&self.x_full) {
-                *x += (full - *x) * s;
-            }
+            self.bounce.hold(bodies, brought, bounced, &mut self.x);
         }
         for (row, &x) in self.rows.iter().zip(&self.x) {
             let local = |i: u32| {

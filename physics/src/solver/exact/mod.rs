@@ -11,7 +11,7 @@ mod pin_island;
 mod separation;
 pub(crate) mod system;
 
-use super::bounce::{KeptVelocities, bounce_share, gains_energy, mix_velocities};
+use super::bounce::{BounceGuard, gains_energy};
 use super::contact::{Contact, ContactMemory};
 use super::impacts::{ImpactPass, Kick};
 use super::island::{IslandGrouping, island_ranges};
@@ -81,10 +81,7 @@ pub(crate) struct SimultaneousSolver {
     pub propagate_impacts: bool,
     /// A bouncing solve's bodies' velocities before it, after it, and after the same
     /// solve without a bounce, with the bouncing answer's impulses (`bounce`).
-    before_bounce: KeptVelocities,
-    full_bounce: KeptVelocities,
-    inelastic: KeptVelocities,
-    x_full: Vec<f64>,
+    bounce: BounceGuard,
 }
 
 impl SimultaneousSolver {
@@ -164,36 +161,16 @@ impl SimultaneousSolver {
             .map(|(_, c)| (c.body_a.0, c.body_b.0));
         let joint_ends = self.island_joints.iter().map(|j| (j.body_a, j.body_b));
         let ends = contact_ends.chain(joint_ends).flat_map(|(a, b)| [a, b]);
-        self.before_bounce.keep(bodies, ends);
-        let brought = self.before_bounce.kinetic_energy(bodies);
+        let brought = self.bounce.before(bodies, ends);
         solve(self, bodies, targets);
-        self.full_bounce.keep_like(&self.before_bounce, bodies);
-        let bounced = self.full_bounce.kinetic_energy(bodies);
+        let bounced = self.bounce.bounced(bodies);
         if !gains_energy(brought, bounced) {
             return;
         }
-        self.x_full.clear();
-        self.x_full.extend_from_slice(&self.x);
-        self.before_bounce.restore(bodies);
-        let inelastic = VelocityTargets {
-            bounce_below: f64::INFINITY,
-            ..*targets
-        };
-        solve(self, bodies, &inelastic);
+        self.bounce.undo_bounce(bodies, &self.x);
+        solve(self, bodies, &targets.without_bounce());
         self.reports.pop(); // the island's report is the first solve's
-        self.inelastic.keep_like(&self.before_bounce, bodies);
-        // Where motors work, the solve without a bounce may leave more than was brought.
-        let allowed = brought.max(self.inelastic.kinetic_energy(bodies));
-        if !gains_energy(allowed, bounced) {
-            self.full_bounce.restore(bodies);
-            self.x.copy_from_slice(&self.x_full);
-            return;
-        }
-        let s = bounce_share(&self.inelastic, &self.full_bounce, bodies, allowed);
-        mix_velocities(&self.inelastic, &self.full_bounce, s, bodies);
-        for (x, &full) in self.x.iter_mut().zip(&self.x_full) {
-            *x += (full - *x) * s;
-        }
+        self.bounce.hold(bodies, brought, bounced, &mut self.x);
     }
 
     /// Starting impulses for the rows from the last solve's, for contacts that persist.

@@ -108,6 +108,17 @@ pub(crate) struct VelocityTargets {
     pub friction: bool,
 }
 
+impl VelocityTargets {
+    /// The same targets with no contact bouncing: the inelastic answer a bounce is held
+    /// against (`solver::bounce`).
+    pub(crate) fn without_bounce(&self) -> Self {
+        Self {
+            bounce_below: f64::INFINITY,
+            ..*self
+        }
+    }
+}
+
 /// Builds the velocity-level rows of one island.
 pub(crate) fn velocity_rows(
     contacts: &[(u32, Contact)],
