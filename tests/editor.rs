@@ -91,16 +91,23 @@ fn drag_screen_holding(
     moves: usize,
     modifiers: Modifiers,
 ) {
+    press_and_move(h, start, end, moves, modifiers);
+    release(h, end, modifiers);
+}
+
+/// Presses the primary button at screen point `start` and moves to `end` in `moves`
+/// frames, `modifiers` held, the button still down.
+fn press_and_move(
+    h: &mut Harness<'_, RoboSimApp>,
+    start: Pos2,
+    end: Pos2,
+    moves: usize,
+    modifiers: Modifiers,
+) {
     h.event(Event::ModifiersChanged(modifiers));
     h.event(Event::PointerMoved(start));
     h.run_steps(1);
-    let button = |pos, pressed| Event::PointerButton {
-        pos,
-        button: PointerButton::Primary,
-        pressed,
-        modifiers,
-    };
-    h.event(button(start, true));
+    h.event(primary_button(start, true, modifiers));
     h.run_steps(1);
     for k in 1..=moves {
         h.event(Event::PointerMoved(
@@ -108,8 +115,21 @@ fn drag_screen_holding(
         ));
         h.run_steps(1);
     }
-    h.event(button(end, false));
+}
+
+/// Releases the primary button at screen point `at`.
+fn release(h: &mut Harness<'_, RoboSimApp>, at: Pos2, modifiers: Modifiers) {
+    h.event(primary_button(at, false, modifiers));
     h.run_steps(2);
+}
+
+fn primary_button(pos: Pos2, pressed: bool, modifiers: Modifiers) -> Event {
+    Event::PointerButton {
+        pos,
+        button: PointerButton::Primary,
+        pressed,
+        modifiers,
+    }
 }
 
 fn click(h: &mut Harness<'_, RoboSimApp>, label: &str) {

@@ -1,8 +1,10 @@
 //! A scene as it runs: pulling bodies, the plots, the solver, live edits, scrubbing
 //! back, Follow, previews and the edits that must restart a run (issue 64).
 
-use super::{click, click_world, harness, open_at_step_0, scratch_db, type_into};
-use egui::{Event, Key, Modifiers, PointerButton};
+use super::{
+    click, click_world, harness, open_at_step_0, press_and_move, release, scratch_db, type_into,
+};
+use egui::{Event, Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use robosim::app::{RoboSimApp, Selection};
@@ -32,22 +34,7 @@ fn a_body_pulled_while_following_stays_by_the_pointer() {
         let wanted = pe::Vec2::new(p.x + 60.0, p.y);
         (screen(p.x, p.y), screen(wanted.x, wanted.y), wanted)
     };
-    h.event(Event::PointerMoved(start));
-    h.run_steps(1);
-    let button = |pos, pressed| Event::PointerButton {
-        pos,
-        button: PointerButton::Primary,
-        pressed,
-        modifiers: Modifiers::NONE,
-    };
-    h.event(button(start, true));
-    h.run_steps(1);
-    for k in 1..=6 {
-        h.event(Event::PointerMoved(
-            start + (target - start) * (k as f32 / 6.0),
-        ));
-        h.run_steps(1);
-    }
+    press_and_move(&mut h, start, target, 6, Modifiers::NONE);
     let steps_before = h.state().sim().unwrap().step_count();
     for _ in 0..120 {
         h.run_steps(1);
@@ -74,8 +61,7 @@ fn a_body_pulled_while_following_stays_by_the_pointer() {
         wanted.x,
         wanted.y
     );
-    h.event(button(target, false));
-    h.run_steps(2);
+    release(&mut h, target, Modifiers::NONE);
 }
 
 /// Choosing another body while a scene runs changes what the plots show, not what they
@@ -97,18 +83,7 @@ fn choosing_another_body_keeps_every_plot_series_from_step_0() {
         let sim = app.sim().unwrap();
         let body = sim.bodies.iter().find(|b| b.id == id).unwrap();
         let at = sim.world.body(body.handle).unwrap().position;
-        let pos = app.camera().to_screen(app.canvas_rect(), at);
-        h.event(Event::PointerMoved(pos));
-        h.run_steps(1);
-        for pressed in [true, false] {
-            h.event(Event::PointerButton {
-                pos,
-                button: PointerButton::Primary,
-                pressed,
-                modifiers: Modifiers::NONE,
-            });
-            h.run_steps(1);
-        }
+        click_world(&mut h, at.x, at.y, Modifiers::NONE);
     }
     h.run_steps(5);
     let app = h.state();
@@ -195,22 +170,7 @@ fn the_back_slider_holds_the_step_under_a_still_pointer() {
     // Press at the slider's right end, move 20 points left, and hold for 30 frames.
     let start = egui::pos2(slider.right() - 2.0, slider.center().y);
     let end = start - egui::vec2(20.0, 0.0);
-    h.event(Event::PointerMoved(start));
-    h.run_steps(1);
-    let button = |pos, pressed| Event::PointerButton {
-        pos,
-        button: PointerButton::Primary,
-        pressed,
-        modifiers: Modifiers::NONE,
-    };
-    h.event(button(start, true));
-    h.run_steps(1);
-    for k in 1..=5 {
-        h.event(Event::PointerMoved(
-            start + (end - start) * (k as f32 / 5.0),
-        ));
-        h.run_steps(1);
-    }
+    press_and_move(&mut h, start, end, 5, Modifiers::NONE);
     let shown = h.state().sim().unwrap().step_count();
     assert!(shown < newest, "scrubbed back from {newest} to {shown}");
     for _ in 0..30 {
@@ -218,8 +178,7 @@ fn the_back_slider_holds_the_step_under_a_still_pointer() {
         h.run_steps(1);
         assert_eq!(h.state().sim().unwrap().step_count(), shown, "held still");
     }
-    h.event(button(end, false));
-    h.run_steps(2);
+    release(&mut h, end, Modifiers::NONE);
     assert_eq!(h.state().sim().unwrap().step_count(), shown);
     // Going on from there drops what came after it.
     click(&mut h, "Step");

@@ -1,7 +1,10 @@
 //! Rubber-band selection at step 0 and the edits that apply to every selected placement
 //! at once, each one undo step.
 
-use super::{click_world, drag_world, drag_world_holding, harness, open_at_step_0, scratch_db};
+use super::{
+    click_world, drag_world, drag_world_holding, harness, open_at_step_0, primary_button, release,
+    scratch_db,
+};
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -257,13 +260,7 @@ fn the_rotate_handle_turns_by_the_angle_swept() {
         };
         h.event(egui::Event::PointerMoved(handle));
         h.run_steps(1);
-        let button = |pos, pressed| egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: Modifiers::NONE,
-        };
-        h.event(button(at(0.0), true));
+        h.event(primary_button(at(0.0), true, Modifiers::NONE));
         h.run_steps(1);
         for k in 1..=moves {
             h.event(egui::Event::PointerMoved(at(
@@ -273,8 +270,7 @@ fn the_rotate_handle_turns_by_the_angle_swept() {
             // A frame with the pointer at rest between moves, as a real mouse gives.
             h.run_steps(1);
         }
-        h.event(button(at(sweep), false));
-        h.run_steps(2);
+        release(&mut h, at(sweep), Modifiers::NONE);
         let turned = body(&stack(&h), "box 3").orientation - before;
         assert!(
             (turned - f64::from(sweep).to_radians()).abs() < 0.5f64.to_radians(),
