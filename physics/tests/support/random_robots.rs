@@ -279,28 +279,13 @@ pub fn random_robot(draw: &mut Draw, solver: ContactSolver) -> Trial {
     let floor_placed = placing != Placing::FreeSpace;
     if floor_placed {
         // A floor under the robot's lowest point, or a fraction of its height above it.
-        let lowest = bodies
+        let ys: Vec<f64> = bodies
             .iter()
-            .flat_map(|&h| {
-                world
-                    .body(h)
-                    .expect("a body")
-                    .world_vertices()
-                    .collect::<Vec<_>>()
-            })
+            .flat_map(|&h| world.body(h).expect("a body").world_vertices())
             .map(|v| v.y)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let highest = bodies
-            .iter()
-            .flat_map(|&h| {
-                world
-                    .body(h)
-                    .expect("a body")
-                    .world_vertices()
-                    .collect::<Vec<_>>()
-            })
-            .map(|v| v.y)
-            .fold(f64::INFINITY, f64::min);
+            .collect();
+        let lowest = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let highest = ys.iter().copied().fold(f64::INFINITY, f64::min);
         let sunk = if placing == Placing::PartlyInFloor {
             draw.uniform(0.1, 0.6) * (lowest - highest)
         } else {
