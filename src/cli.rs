@@ -287,11 +287,12 @@ pub fn run(args: &RunArgs) -> Result<ExitCode, Failure> {
     // one line and does not stop the run.
     // (A scene that did not load may be among the records a broken file lost: then every
     // error is the scene's business.)
-    let found = database.model.scene(&args.scene).is_some();
-    let scene_problems = if found {
-        database.scene_problems(&args.scene)
+    let own_problems;
+    let scene_problems = if database.model.scene(&args.scene).is_some() {
+        own_problems = database.scene_problems(&args.scene);
+        &own_problems
     } else {
-        problems.clone()
+        &problems
     };
     let errors: Vec<&Problem> = scene_problems.iter().filter(|p| p.is_error()).collect();
     if let Some(first) = errors.first() {

@@ -53,7 +53,7 @@ pub struct Runner {
     /// What the solver was chosen for: the scene (or preview) shown, and the solver its
     /// file names. Another one shown, or its own solver changed, takes up its own solver
     /// (or the default), not the last one's choice.
-    solver_for: Option<(String, Option<ContactSolver>)>,
+    solver_for: Option<(Selection, Option<ContactSolver>)>,
     /// Whether bodies at rest sleep in the simulations the app runs.
     pub sleeping: bool,
     /// The body held by the mouse while running.
@@ -142,7 +142,7 @@ impl Runner {
             .and_then(|name| ContactSolver::from_name(name.trim()));
         // The toolbar's choice stays with what it was made for (through edits and
         // resets); another scene shown starts from its own solver.
-        let shown = (format!("{selection:?}"), own);
+        let shown = (selection.clone(), own);
         if self.solver_for.as_ref() != Some(&shown) {
             self.solver = own.unwrap_or_default();
             self.solver_for = Some(shown);
