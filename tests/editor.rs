@@ -29,6 +29,19 @@ fn harness(dir: &Path) -> Harness<'static, RoboSimApp> {
     h
 }
 
+/// The app on `dir`'s database, asking for paths through `files`.
+fn harness_with_files(
+    dir: &Path,
+    files: robosim::app::files::Scripted,
+) -> Harness<'static, RoboSimApp> {
+    let app = RoboSimApp::new(Some(dir.to_path_buf())).with_file_chooser(Box::new(files));
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1280.0, 800.0))
+        .build_eframe(move |_| app);
+    h.run_steps(3);
+    h
+}
+
 /// Clicks the canvas at world point (x, y).
 fn click_world(h: &mut Harness<'_, RoboSimApp>, x: f64, y: f64, modifiers: Modifiers) {
     let app = h.state();
@@ -776,26 +789,6 @@ fn a_db_folder_that_does_not_exist_is_asked_about_not_opened_silently() {
 }
 
 #[test]
-fn open_without_a_file_dialog_says_so_and_offers_the_path_field() {
-    use robosim::app::files::{Answer, Scripted};
-    let dir = scratch_db();
-    let app = RoboSimApp::new(Some(dir.path().to_path_buf()))
-        .with_file_chooser(Box::new(Scripted::new([Answer::Unavailable])));
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1280.0, 800.0))
-        .build_eframe(move |_| app);
-    h.run_steps(3);
-    click(&mut h, "Open…");
-    h.run_steps(2);
-    assert!(
-        h.state().status().contains("type the folder"),
-        "{}",
-        h.state().status()
-    );
-    assert!(h.get_by_label("folder").is_focused());
-}
-
-#[test]
 fn a_refused_rename_shows_the_current_name_again() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
@@ -1024,6 +1017,8 @@ fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() 
 }
 
 // More of the editor's tests, a file per feature.
+#[path = "editor/chooser.rs"]
+mod chooser;
 #[path = "editor/drawing.rs"]
 mod drawing;
 #[path = "editor/export.rs"]

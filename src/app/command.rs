@@ -29,6 +29,48 @@ pub enum ImageFormat {
     Svg,
 }
 
+/// What the app writes besides the database, each where the user says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Export {
+    /// The plotted series as CSV.
+    Plots,
+    /// The canvas as a picture.
+    View(ImageFormat),
+    /// The run shown, from step 0 to the step shown (or 10 s), as an animated GIF.
+    Gif,
+}
+
+impl Export {
+    /// The file's extension, without its dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Export::Plots => "csv",
+            Export::View(ImageFormat::Png) => "png",
+            Export::View(ImageFormat::Svg) => "svg",
+            Export::Gif => "gif",
+        }
+    }
+
+    /// What the file holds, as its name and the status bar say it.
+    pub fn what(self) -> &'static str {
+        match self {
+            Export::Plots => "plots",
+            Export::View(_) => "view",
+            Export::Gif => "run",
+        }
+    }
+
+    /// The title of the question where to write it.
+    pub fn title(self) -> &'static str {
+        match self {
+            Export::Plots => "Export the plots as CSV",
+            Export::View(ImageFormat::Png) => "Export the view as PNG",
+            Export::View(ImageFormat::Svg) => "Export the view as SVG",
+            Export::Gif => "Export the run as GIF",
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum Command {
     // Files.
@@ -43,16 +85,18 @@ pub enum Command {
     SaveThen(AfterSave),
     Save,
     SaveAs,
+    /// Save the database in this folder (chosen in the app's own file chooser).
+    SaveIn(PathBuf),
     /// Save although some body cannot be simulated (the user was asked).
     SaveAnyway,
     /// Save over files changed on disk, or dropping unreadable records (the user was asked).
     SaveOverwriting,
     Revert,
     Quit,
-    ExportPlots,
-    ExportView(ImageFormat),
-    /// Record the run shown, from step 0 to the step shown (or 10 s), as an animated GIF.
-    ExportGif,
+    /// Ask where, then write the export.
+    Export(Export),
+    /// Write the export to this file (chosen in the app's own file chooser).
+    ExportTo(Export, PathBuf),
     /// Take up (or forget) the unsaved work an earlier session kept for `folder`.
     Restore(Option<PathBuf>, Model),
     /// An edit of a scene that has run, confirmed: made, and the scene built again at

@@ -1,9 +1,9 @@
 //! Commands that read or write files: open, save (asking first when it matters), revert,
 //! unsaved work kept against a crash, and exports of the plots and the view.
 
-use super::command::{AfterSave, ImageFormat};
+use super::command::{AfterSave, Export, ImageFormat};
 use super::dialogs::Dialog;
-use super::files::Answer;
+use super::files::{Answer, InAppChooser, PathFor};
 use super::{Command, RoboSimApp, Selection, document, plots};
 use crate::animation;
 use crate::db::{Overwrite, SaveError};
@@ -24,13 +24,17 @@ impl RoboSimApp {
             }
             Command::Save => self.save(Overwrite::Never, false, None),
             Command::SaveAs => self.save_as(),
+            Command::SaveIn(dir) => self.save(Overwrite::Never, false, Some(dir)),
             Command::SaveAnyway => self.save(Overwrite::Never, true, None),
             Command::SaveOverwriting => self.save(Overwrite::Confirmed, true, None),
             Command::Revert => self.revert(),
             Command::Quit => self.leave_for(AfterSave::Quit, ctx),
-            Command::ExportPlots => self.export_plots(),
-            Command::ExportView(format) => self.export_view(format, ctx),
-            Command::ExportGif => self.export_gif(ctx),
+            Command::Export(export) => {
+                if let Some(path) = self.export_path(export) {
+                    self.export_to(export, path, ctx);
+                }
+            }
+            Command::ExportTo(export, path) => self.export_to(export, path, ctx),
             Command::Restore(folder, model) => self.restore(folder, model, now),
             Command::DiscardKeptWork(folder) => self.doc.discard_kept_work(folder.as_deref()),
             _ => {}
@@ -83,24 +87,24 @@ impl RoboSimApp {
 
     /// Asks for a database folder and opens it.
     fn ask_and_open(&mut self, ctx: &egui::Context) {
-        match self
-            .files
-            .folder("Open a database folder", self.doc.folder())
-        {
-            Answer::Chosen(dir) => self.leave_for(AfterSave::Open(dir), ctx),
-            Answer::Cancelled => {}
-            Answer::Unavailable => self.no_file_dialog(),
+        if let Some(dir) = self.ask_folder("Open a database folder", PathFor::OpenDatabase) {
+            self.leave_for(AfterSave::Open(dir), ctx);
         }
     }
 
-    /// The system's file dialog could not open: say so, and offer the path field.
-    fn no_file_dialog(&mut self) {
-        self.complain(
-            "no file dialog could open (no desktop portal or zenity): type the folder in the \
-             path field and press Enter"
-                .into(),
-        );
-        self.toolbar.focus_path_field = true;
+    /// Asks for a folder in the system's dialog and returns it; where the system has no
+    /// dialog, opens the app's own chooser, which carries on with `purpose` once answered.
+    fn ask_folder(&mut self, title: &str, purpose: PathFor) -> Option<PathBuf> {
+        let start = self.doc.folder().map(Path::to_path_buf);
+        if !self.no_system_dialog {
+            match self.files.folder(title, start.as_deref()) {
+                Answer::Chosen(dir) => return Some(dir),
+                Answer::Cancelled => return None,
+                Answer::Unavailable => self.no_system_dialog = true,
+            }
+        }
+        self.in_app_chooser = Some(InAppChooser::folder(title, start.as_deref(), purpose));
+        None
     }
 
     /// Makes the database in `folder` (or the examples) the one edited.
@@ -133,10 +137,9 @@ impl RoboSimApp {
             None => {
                 let typed = self.toolbar.path_input.trim();
                 if typed.is_empty() {
-                    match self.files.folder("Save the database in…", None) {
-                        Answer::Chosen(dir) => Some(dir),
-                        Answer::Cancelled => return,
-                        Answer::Unavailable => return self.no_file_dialog(),
+                    match self.ask_folder("Save the database in…", PathFor::SaveDatabase) {
+                        Some(dir) => Some(dir),
+                        None => return,
                     }
                 } else {
                     Some(PathBuf::from(typed))
@@ -160,13 +163,8 @@ impl RoboSimApp {
     }
 
     fn save_as(&mut self) {
-        match self
-            .files
-            .folder("Save the database in…", self.doc.folder())
-        {
-            Answer::Chosen(dir) => self.save(Overwrite::Never, false, Some(dir)),
-            Answer::Cancelled => {}
-            Answer::Unavailable => self.no_file_dialog(),
+        if let Some(dir) = self.ask_folder("Save the database in…", PathFor::SaveDatabase) {
+            self.save(Overwrite::Never, false, Some(dir));
         }
     }
 
@@ -203,25 +201,54 @@ impl RoboSimApp {
     }
 
     /// A file name for an export of what the canvas shows.
-    fn export_name(&self, what: &str, extension: &str) -> String {
+    fn export_name(&self, export: Export) -> String {
         let shown = match &self.selection {
             Some(Selection::Scene(n) | Selection::Robot(n) | Selection::Body(n)) => n.clone(),
             None => "robosim".to_string(),
         };
-        format!("{shown} {what}.{extension}")
+        format!("{shown} {}.{}", export.what(), export.extension())
     }
 
-    /// Where to write an export: a file the user names, or (with no dialog) next to the
-    /// database; None when the user cancelled.
-    fn export_path(&mut self, title: &str, name: String, extension: &str) -> Option<PathBuf> {
+    /// Asks where to write an export, starting in the database's folder; None when the
+    /// user cancelled, or when the app's own chooser asks (it carries on once answered).
+    fn export_path(&mut self, export: Export) -> Option<PathBuf> {
+        if export != Export::Plots && self.runner.sim().is_none() {
+            self.complain(format!(
+                "nothing to export: no scene is shown ({})",
+                export.what()
+            ));
+            return None;
+        }
         let folder = self.doc.folder().map(Path::to_path_buf);
-        match self
-            .files
-            .new_file(title, &name, extension, folder.as_deref())
-        {
-            Answer::Chosen(path) => Some(path),
-            Answer::Cancelled => None,
-            Answer::Unavailable => Some(folder.unwrap_or_default().join(name)),
+        let (title, name, extension) =
+            (export.title(), self.export_name(export), export.extension());
+        if !self.no_system_dialog {
+            match self
+                .files
+                .new_file(title, &name, extension, folder.as_deref())
+            {
+                Answer::Chosen(path) => return Some(path),
+                Answer::Cancelled => return None,
+                Answer::Unavailable => self.no_system_dialog = true,
+            }
+        }
+        self.in_app_chooser = Some(InAppChooser::export_file(
+            title,
+            &name,
+            folder.as_deref(),
+            export,
+        ));
+        None
+    }
+
+    fn export_to(&mut self, export: Export, path: PathBuf, ctx: &egui::Context) {
+        match export {
+            Export::Plots => {
+                let csv = plots::to_csv(&self.runner.plot_data);
+                self.write_export(&path, csv.as_bytes(), "plots");
+            }
+            Export::View(format) => self.export_view(format, path, ctx),
+            Export::Gif => self.export_gif(path, ctx),
         }
     }
 
@@ -232,25 +259,8 @@ impl RoboSimApp {
         }
     }
 
-    /// Writes the plotted series to a CSV file.
-    fn export_plots(&mut self) {
-        let name = self.export_name("plots", "csv");
-        if let Some(path) = self.export_path("Export the plots as CSV", name, "csv") {
-            let csv = plots::to_csv(&self.runner.plot_data);
-            self.write_export(&path, csv.as_bytes(), "plots");
-        }
-    }
-
     /// Writes the canvas as SVG now, or asks egui for a screenshot to write as PNG.
-    fn export_view(&mut self, format: ImageFormat, ctx: &egui::Context) {
-        let (extension, title) = match format {
-            ImageFormat::Svg => ("svg", "Export the view as SVG"),
-            ImageFormat::Png => ("png", "Export the view as PNG"),
-        };
-        let name = self.export_name("view", extension);
-        let Some(path) = self.export_path(title, name, extension) else {
-            return;
-        };
+    fn export_view(&mut self, format: ImageFormat, path: PathBuf, ctx: &egui::Context) {
         match format {
             ImageFormat::Svg => {
                 let Some(sim) = self.runner.sim() else {
@@ -315,7 +325,7 @@ impl RoboSimApp {
     /// seconds to simulate and encode): from step 0 to the step shown, or the first 10 s
     /// when it is at step 0. Mouse pulls and the world's edge are the window's alone: the
     /// recording is the scene's own physics.
-    fn export_gif(&mut self, ctx: &egui::Context) {
+    fn export_gif(&mut self, path: PathBuf, ctx: &egui::Context) {
         let Some(mut sim) = self.runner.sim().cloned() else {
             return self.complain("nothing to record: no scene is shown".into());
         };
@@ -324,10 +334,6 @@ impl RoboSimApp {
             shown => shown,
         };
         sim.reset();
-        let name = self.export_name("run", "gif");
-        let Some(path) = self.export_path("Export the run as GIF", name, "gif") else {
-            return;
-        };
         self.inform(format!("recording {steps} steps as a GIF…"));
         let news = self.export_news.clone();
         let repaint = ctx.clone();

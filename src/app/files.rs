@@ -1,7 +1,8 @@
 //! Asking the user for a folder or a file name. The system's dialog (rfd) may be missing
-//! (no desktop portal, no zenity): then the app says so and offers its path field. Tests
-//! answer with a script instead.
+//! (no desktop portal, no zenity): then the app asks in a chooser of its own, drawn in its
+//! window (egui_file), and carries on when that is answered. Tests answer with a script.
 
+use super::command::{AfterSave, Command, Export};
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -89,5 +90,98 @@ impl FileChooser for Scripted {
 
     fn new_file(&mut self, _: &str, _: &str, _: &str, _: Option<&Path>) -> Answer {
         self.0.pop_front().unwrap_or(Answer::Cancelled)
+    }
+}
+
+/// What a path chosen in the app's own chooser is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PathFor {
+    OpenDatabase,
+    SaveDatabase,
+    Export(Export),
+}
+
+impl PathFor {
+    /// The command that carries on with `path`.
+    fn command(self, path: PathBuf) -> Command {
+        match self {
+            PathFor::OpenDatabase => Command::Open(AfterSave::Open(path)),
+            PathFor::SaveDatabase => Command::SaveIn(path),
+            PathFor::Export(export) => Command::ExportTo(export, path),
+        }
+    }
+}
+
+/// The app's own file chooser, shown where the system has no dialog: a window listing
+/// folders, with a path field, a parent-folder button and a new-folder button.
+pub struct InAppChooser {
+    dialog: egui_file::FileDialog,
+    purpose: PathFor,
+}
+
+impl std::fmt::Debug for InAppChooser {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InAppChooser")
+            .field("purpose", &self.purpose)
+            .field("directory", &self.dialog.directory())
+            .finish()
+    }
+}
+
+impl InAppChooser {
+    /// Asks for a folder, starting in `start` (or the working folder).
+    pub fn folder(title: &str, start: Option<&Path>, purpose: PathFor) -> Self {
+        let dialog = egui_file::FileDialog::select_folder()
+            .open_button_text("Choose this folder".into())
+            .file_label_text("New folder:".into())
+            .default_filename("new database");
+        Self::opened(dialog, title, start, purpose)
+    }
+
+    /// Asks for the file to write `export` to, offering `name`; lists only files of its
+    /// kind.
+    pub fn export_file(title: &str, name: &str, start: Option<&Path>, export: Export) -> Self {
+        let suffix = format!(".{}", export.extension());
+        let dialog = egui_file::FileDialog::save_file()
+            .save_button_text("Export".into())
+            .default_filename(name)
+            .show_files_filter(Box::new(move |path: &Path| {
+                path.to_string_lossy().ends_with(suffix.as_str())
+            }));
+        Self::opened(dialog, title, start, PathFor::Export(export))
+    }
+
+    fn opened(
+        dialog: egui_file::FileDialog,
+        title: &str,
+        start: Option<&Path>,
+        purpose: PathFor,
+    ) -> Self {
+        let start = start
+            .map(Path::to_path_buf)
+            .or_else(|| std::env::current_dir().ok())
+            .unwrap_or_default();
+        let mut dialog = dialog
+            .title(title)
+            .initial_path(start)
+            .show_rename(false)
+            .keep_on_top(true);
+        dialog.open();
+        Self { dialog, purpose }
+    }
+
+    /// Draws the chooser. None while it is open; once answered, the command that carries
+    /// on (Some(None) when the user cancelled).
+    pub fn show(&mut self, ctx: &egui::Context) -> Option<Option<Command>> {
+        self.dialog.show(ctx);
+        match self.dialog.state() {
+            egui_file::State::Open => None,
+            egui_file::State::Selected => Some(
+                self.dialog
+                    .path()
+                    .map(|path| self.purpose.command(path.to_path_buf())),
+            ),
+            egui_file::State::Cancelled | egui_file::State::Closed => Some(None),
+        }
     }
 }

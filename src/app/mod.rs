@@ -109,6 +109,10 @@ pub struct RoboSimApp {
     show_guide: bool,
     /// How the app asks for folders and file names.
     files: Box<dyn files::FileChooser>,
+    /// The system has no file dialog (it came back at once): ask in the app's own.
+    no_system_dialog: bool,
+    /// The app's own file chooser, while it asks.
+    in_app_chooser: Option<files::InAppChooser>,
     copied: Option<placements::Clipboard>,
     /// Text for the system clipboard, put there at the end of the frame (Ctrl+C, X).
     clipboard_out: Option<String>,
@@ -143,6 +147,8 @@ impl RoboSimApp {
             show_about: false,
             show_guide: false,
             files: Box::new(files::SystemDialogs),
+            no_system_dialog: false,
+            in_app_chooser: None,
             copied: None,
             clipboard_out: None,
             pasted: None,
@@ -365,9 +371,9 @@ impl RoboSimApp {
             | C::SaveOverwriting
             | C::Revert
             | C::Quit
-            | C::ExportPlots
-            | C::ExportView(_)
-            | C::ExportGif
+            | C::SaveIn(_)
+            | C::Export(_)
+            | C::ExportTo(..)
             | C::Restore(..)
             | C::DiscardKeptWork(_) => self.apply_file_command(command, ctx, now),
             C::SetRunning(on) => self.runner.running = on,
@@ -562,7 +568,7 @@ impl RoboSimApp {
                     if let Some(plots::PlotsCommand::ExportCsv) =
                         self.plots.ui(ui, &self.runner.plot_data, body.as_deref())
                     {
-                        commands.push(Command::ExportPlots);
+                        commands.push(Command::Export(command::Export::Plots));
                     }
                 });
         }
@@ -626,6 +632,12 @@ impl RoboSimApp {
             if self.dialog.as_ref() == Some(&dialog) {
                 self.dialog = None;
             }
+            commands.extend(answer);
+        }
+        if let Some(chooser) = &mut self.in_app_chooser
+            && let Some(answer) = chooser.show(ctx)
+        {
+            self.in_app_chooser = None;
             commands.extend(answer);
         }
         if self.show_problems {

@@ -3,7 +3,7 @@
 //! it has one, shows its shortcut.
 
 use super::canvas::DebugDraw;
-use super::command::{AfterSave, ImageFormat};
+use super::command::{AfterSave, Export, ImageFormat};
 use super::runner::SPEEDS;
 use super::shortcuts::{self, Action};
 use super::tools::{self, Tool};
@@ -36,8 +36,6 @@ pub struct State<'a> {
 #[derive(Debug, Default)]
 pub struct Toolbar {
     pub path_input: String,
-    /// Give the path field the keyboard focus next frame.
-    pub focus_path_field: bool,
     pub recent: Vec<String>,
 }
 
@@ -171,7 +169,7 @@ impl Toolbar {
             None,
             "Every plotted series, one row per step",
         ) {
-            out.push(Command::ExportPlots);
+            out.push(Command::Export(Export::Plots));
         }
         if entry(
             ui,
@@ -180,7 +178,7 @@ impl Toolbar {
             None,
             "The canvas as a vector drawing",
         ) {
-            out.push(Command::ExportView(ImageFormat::Svg));
+            out.push(Command::Export(Export::View(ImageFormat::Svg)));
         }
         if entry(
             ui,
@@ -189,7 +187,7 @@ impl Toolbar {
             None,
             "The canvas as a picture",
         ) {
-            out.push(Command::ExportView(ImageFormat::Png));
+            out.push(Command::Export(Export::View(ImageFormat::Png)));
         }
         if entry(
             ui,
@@ -198,7 +196,7 @@ impl Toolbar {
             None,
             "The run from step 0 to the step shown (the first 10 s at step 0) as an animated GIF, 640 × 480, to share",
         ) {
-            out.push(Command::ExportGif);
+            out.push(Command::Export(Export::Gif));
         }
         ui.separator();
         if entry(
@@ -240,10 +238,7 @@ impl Toolbar {
                     .desired_width(100.0),
             )
             .labelled_by(label.id)
-            .on_hover_text("Type a folder and press Enter (for machines without a file dialog)");
-        if std::mem::take(&mut self.focus_path_field) {
-            typed.request_focus();
-        }
+            .on_hover_text("Type a database folder and press Enter to open it");
         if typed.lost_focus()
             && ui.input(|i| i.key_pressed(egui::Key::Enter))
             && !self.path_input.trim().is_empty()
