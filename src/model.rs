@@ -60,8 +60,28 @@ pub struct JointMotorDef {
     pub time1: u64,
     pub angular: f64,
     pub max_torque: f64,
+    /// Extension (attribute `period`, steps; 0: none): the motor turns at +angular for the
+    /// first half of every `period` steps from time0 and at −angular for the second half,
+    /// so that its joint swings to and fro through angular·period/2: a gait.
+    pub period: u64,
     pub extra: ExtraAttributes,
     pub location: Location,
+}
+
+impl JointMotorDef {
+    /// The speed (radians per step) the motor drives at during `step`; None outside its
+    /// window.
+    pub fn angular_at(&self, step: u64) -> Option<f64> {
+        if !(self.time0..self.time1).contains(&step) {
+            return None;
+        }
+        let backwards = self.period > 0 && (step - self.time0) % self.period >= self.period / 2;
+        Some(if backwards {
+            -self.angular
+        } else {
+            self.angular
+        })
+    }
 }
 
 /// A placement `local` (x, y, orientation) given in a parent `frame` (x, y, orientation),

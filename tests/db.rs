@@ -162,16 +162,16 @@ fn model() -> impl Strategy<Value = Model> {
             increase: i,
             ..Default::default()
         });
-    let joint_motor =
-        (0u64..10_000, 0u64..10_000, number(), number()).prop_map(|(t0, t1, a, m)| {
-            robosim::model::JointMotorDef {
-                time0: t0,
-                time1: t1,
-                angular: a,
-                max_torque: m,
-                ..Default::default()
-            }
-        });
+    let joint_motor = (0u64..10_000, 0u64..10_000, number(), number(), 0u64..100).prop_map(
+        |(t0, t1, a, m, period)| robosim::model::JointMotorDef {
+            time0: t0,
+            time1: t1,
+            angular: a,
+            max_torque: m,
+            period,
+            ..Default::default()
+        },
+    );
     let joint = (
         name(),
         name(),

@@ -261,20 +261,8 @@ impl Runner {
 
     /// Every joint motor at `throttle` × its speed in the files (rad/step ÷ h).
     fn apply_throttle(&mut self) {
-        let throttle = self.throttle;
-        let Some(sim) = &mut self.sim else {
-            return;
-        };
-        let dt = sim.dt;
-        let motors: Vec<_> = sim
-            .joints
-            .iter()
-            .filter_map(|j| j.motor_window.map(|(_, _, w)| (j.handle, w)))
-            .collect();
-        for (handle, angular) in motors {
-            if let Some(m) = sim.world.joint_motor_mut(handle) {
-                m.target_speed = throttle * crate::sim::pe_joint_speed(angular, dt);
-            }
+        if let Some(sim) = &mut self.sim {
+            sim.motor_throttle = self.throttle;
         }
     }
 

@@ -93,6 +93,9 @@ pub fn joint_motor_problems(m: &JointMotorDef) -> Vec<String> {
     if m.max_torque < 0.0 {
         out.push(format!("maxTorque {} must be ≥ 0", m.max_torque));
     }
+    if m.period == 1 {
+        out.push("period 1 has no second half to turn back in: use 2 or more".to_string());
+    }
     out.extend(beyond_all(&[
         ("angular", m.angular, limits::ANGULAR),
         ("maxTorque", m.max_torque, limits::TORQUE),

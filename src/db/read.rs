@@ -103,6 +103,16 @@ impl<'a> Fields<'a> {
     /// A step count: a whole number ≥ 0 (written as a float by some programs: `1e+003`).
     fn steps(&mut self, key: &'static str) -> u64 {
         let v = self.number(key);
+        self.whole_steps(key, v)
+    }
+
+    /// A step count that may be left out.
+    fn optional_steps(&mut self, key: &'static str) -> Option<u64> {
+        let v = self.optional_number(key)?;
+        Some(self.whole_steps(key, v))
+    }
+
+    fn whole_steps(&mut self, key: &'static str, v: f64) -> u64 {
         if v < 0.0 || v.fract() != 0.0 || v > 9.0e15 {
             self.fail(format!("{key}={v} is not a whole number of steps"));
             return 0;
@@ -327,6 +337,7 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
                             time1: f.steps("time1"),
                             angular: f.number("angular"),
                             max_torque: f.number("maxTorque"),
+                            period: f.optional_steps("period").unwrap_or(0),
                             extra: Vec::new(),
                             location: m.location,
                         };

@@ -172,13 +172,15 @@ pub fn robot(r: &Robot, out: &mut String) {
             None => tag.empty(out),
             Some(m) => {
                 tag.start(out);
-                Tag::open(6, "motor")
+                let mut motor = Tag::open(6, "motor")
                     .num("time0", m.time0 as f64)
                     .num("time1", m.time1 as f64)
                     .num("angular", m.angular)
-                    .num("maxTorque", m.max_torque)
-                    .extra(&m.extra)
-                    .empty(out);
+                    .num("maxTorque", m.max_torque);
+                if m.period > 0 {
+                    motor = motor.num("period", m.period as f64);
+                }
+                motor.extra(&m.extra).empty(out);
                 out.push_str("    </joint>\n");
             }
         }

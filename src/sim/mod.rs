@@ -41,8 +41,8 @@ pub struct SimJoint {
     /// `"{robot}#{i}/{bodyA}-{bodyB}"`, unique as `SimBody::id` is.
     pub id: String,
     pub handle: JointHandle,
-    /// The motor's window in steps and target in radians per step, if it has one.
-    pub motor_window: Option<(u64, u64, f64)>,
+    /// The joint's motor as the files give it (its window, speed and swing), if any.
+    pub motor: Option<crate::model::JointMotorDef>,
     /// The joint in the files: the scene's `robot`-th `<robot>`, its `joint`-th joint.
     pub defined_by: (usize, usize),
 }
@@ -77,6 +77,8 @@ pub struct Simulation {
     /// Which body each body motor drives, by index into `bodies`.
     body_motor_owners: Vec<usize>,
     pub dt: f64,
+    /// Every joint motor runs at this times its speed in the files (the app's throttle).
+    pub motor_throttle: f64,
     pub scene_name: String,
     model: Model,
     solver: ContactSolver,
@@ -155,6 +157,7 @@ impl Simulation {
             joints: Vec::new(),
             body_motor_owners: Vec::new(),
             dt,
+            motor_throttle: 1.0,
             scene_name: scene.name.clone(),
             model: model.clone(),
             solver,
@@ -301,16 +304,18 @@ impl Simulation {
     ) -> Result<(), String> {
         let mut def = pe::JointDef::new(a, Some(b), anchor);
         def.collide_connected = joint.collide;
-        let mut motor_window = None;
         if let Some(m) = &joint.motor {
             if let Some(problem) = db::joint_motor_problems(m).into_iter().next() {
                 return Err(format!("{id}: motor: {problem}"));
             }
+            let at_start = m.angular_at(0);
             def.motor = Some(JointMotor {
-                enabled: (m.time0..m.time1).contains(&0),
-                ..JointMotor::new(pe_joint_speed(m.angular, self.dt), m.max_torque)
+                enabled: at_start.is_some(),
+                ..JointMotor::new(
+                    pe_joint_speed(at_start.unwrap_or(m.angular), self.dt),
+                    m.max_torque,
+                )
             });
-            motor_window = Some((m.time0, m.time1, m.angular));
         }
         let handle = self
             .world
@@ -319,7 +324,7 @@ impl Simulation {
         self.joints.push(SimJoint {
             id,
             handle,
-            motor_window,
+            motor: joint.motor.clone(),
             defined_by,
         });
         Ok(())
@@ -341,11 +346,10 @@ impl Simulation {
         self.dt = dt;
         for (handle, m) in motors {
             if let Some(motor) = self.world.joint_motor_mut(handle) {
-                motor.target_speed = pe_joint_speed(m.angular, dt);
                 motor.max_torque = m.max_torque;
             }
             if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
-                j.motor_window = Some((m.time0, m.time1, m.angular));
+                j.motor = Some(m);
             }
         }
         self.model = model.clone();
@@ -413,10 +417,11 @@ impl Simulation {
             self.dt,
             self.solver,
         );
-        let sleeping = self.world.settings.sleeping;
+        let (sleeping, throttle) = (self.world.settings.sleeping, self.motor_throttle);
         *self = Self::new(&model, &name, Some(dt), Some(solver))
             .expect("a scene that built once builds again");
         self.world.settings.sleeping = sleeping;
+        self.motor_throttle = throttle;
     }
 
     pub fn step_count(&self) -> u64 {
@@ -432,17 +437,20 @@ impl Simulation {
         let _reported = self.try_step();
     }
 
-    /// One step of `dt`; joint motors switch on and off by their windows. An error names
-    /// what pe refused, or the body whose state left the limits (by its trace id).
+    /// One step of `dt`; joint motors switch on and off by their windows, turn back by
+    /// their periods, and run at `motor_throttle` × their speed. An error names what pe
+    /// refused, or the body whose state left the limits (by its trace id).
     pub fn try_step(&mut self) -> Result<(), String> {
         let step = self.world.step_count();
         for j in &self.joints {
-            if let Some((t0, t1, _)) = j.motor_window
+            if let Some(def) = &j.motor
                 && let Some(m) = self.world.joint_motor_mut(j.handle)
             {
-                m.enabled = (t0..t1).contains(&step);
-                if !m.enabled {
-                    m.last_impulse = 0.0;
+                let angular = def.angular_at(step);
+                m.enabled = angular.is_some();
+                match angular {
+                    Some(w) => m.target_speed = self.motor_throttle * pe_joint_speed(w, self.dt),
+                    None => m.last_impulse = 0.0,
                 }
             }
         }

@@ -97,7 +97,7 @@ fn click_label(h: &mut Harness<'_, RoboSimApp>, label: &str) {
 fn a_polygon_dragged_into_a_robot_is_a_regular_body_of_that_radius_in_the_robot() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    h.get_by_label_contains("housenka ·").click();
+    h.get_by_label("housenka · 3 bodies, 2 joints").click();
     h.run_steps(2);
     assert!(matches!(h.state().selection(), Some(Selection::Robot(_))));
     let before = h.state().model().clone();

@@ -201,7 +201,7 @@ fn copy_paste_and_duplicate_take_the_whole_selection_and_keep_its_shape() {
 fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    h.get_by_label_contains("housenka ·").click();
+    h.get_by_label("housenka · 3 bodies, 2 joints").click();
     h.run_steps(2);
     let before = h.state().model().clone();
     // The housenka's three 40 × 20 bodies at x = −33, 0, 33, pinned h_0–h_1 and h_1–h_2.

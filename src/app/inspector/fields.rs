@@ -305,6 +305,15 @@ pub fn joint_fields(
                     .changed(),
                 );
                 ui.end_row();
+                ui.label("swing period").on_hover_text(
+                    "Steps: forward for the first half of each period, back for the second, so the joint swings to and fro (a gait); 0 turns one way only",
+                );
+                edit.touched(
+                    format!("{key} mp"),
+                    ui.add(DragValue::new(&mut m.period).range(0..=1_000_000).suffix(" steps"))
+                        .changed(),
+                );
+                ui.end_row();
             }
         });
 }
