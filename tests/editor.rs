@@ -835,120 +835,6 @@ fn a_record_that_could_not_be_read_stays_in_the_problems_after_an_unrelated_edit
     );
 }
 
-fn new_body(h: &mut Harness<'_, RoboSimApp>, name: &str) {
-    new_item(h, "body");
-    type_into(h, "name", name);
-    assert!(
-        h.state().model().body(name).is_some(),
-        "{}",
-        h.state().status()
-    );
-}
-
-#[test]
-fn a_new_user_builds_a_two_wheeled_robot_from_nothing_runs_it_saves_and_finds_it_again() {
-    let dir = tempfile::tempdir().unwrap();
-    let mut h = harness(dir.path());
-    assert!(
-        h.state().model().bodies.is_empty(),
-        "an empty folder, an empty database"
-    );
-
-    // A chassis drawn by clicks, a hexagonal wheel and a static floor from the shape tools.
-    new_body(&mut h, "chassis");
-    click(&mut h, "Clear and draw");
-    for (x, y) in [(-40.0, -10.0), (40.0, -10.0), (40.0, 10.0), (-40.0, 10.0)] {
-        click_world(&mut h, x, y, Modifiers::NONE);
-    }
-    new_body(&mut h, "wheel");
-    type_into(&mut h, "r", "18");
-    click(&mut h, "Regular polygon");
-    new_body(&mut h, "floor");
-    type_into(&mut h, "w", "1200");
-    type_into(&mut h, "h", "20");
-    click(&mut h, "Rectangle");
-    type_into(&mut h, "density", "0");
-    let m = h.state().model().clone();
-    assert_eq!(m.body("chassis").unwrap().vertices.len(), 4);
-    assert_eq!(m.body("wheel").unwrap().vertices.len(), 6);
-    assert_eq!(m.body("floor").unwrap().vertices[2], [600.0, 10.0]);
-    assert_eq!(m.body("floor").unwrap().density, 0.0);
-
-    // The robot: the chassis, two wheels dragged under its ends, two pins with motors.
-    new_item(&mut h, "robot");
-    type_into(&mut h, "name", "rover");
-    for body in ["chassis", "wheel", "wheel"] {
-        click(&mut h, "+ body");
-        click(&mut h, body);
-    }
-    let placed = |h: &Harness<'_, RoboSimApp>, k: usize| {
-        let b = &h.state().model().robot("rover").unwrap().bodies[k].placement;
-        (b.x, b.y)
-    };
-    let (x2, y2) = placed(&h, 2);
-    drag_world(&mut h, (x2, y2), (30.0, 5.0));
-    let (x1, y1) = placed(&h, 1);
-    drag_world(&mut h, (x1, y1), (-30.0, 5.0));
-    assert_eq!((placed(&h, 1), placed(&h, 2)), ((-30.0, 5.0), (30.0, 5.0)));
-    click(&mut h, "Add joint");
-    click_world(&mut h, -30.0, 5.0, Modifiers::NONE);
-    click_world(&mut h, 30.0, 5.0, Modifiers::NONE);
-    click(&mut h, "Add joint");
-    let robot = h.state().model().robot("rover").unwrap().clone();
-    assert_eq!(robot.joints.len(), 2, "{}", h.state().status());
-    for header in ["chassis – wheel", "chassis – wheel 2"] {
-        h.get_by_label(header).click();
-        h.run_steps(2);
-    }
-    // The second first: the first one's fields, once shown, push it down.
-    for k in [1, 0] {
-        h.get_all_by_label("joint motor").nth(k).unwrap().click();
-        h.run_steps(2);
-    }
-    let robot = h.state().model().robot("rover").unwrap().clone();
-    assert!(robot.joints.iter().all(|j| j.motor.is_some()), "{robot:#?}");
-
-    // The scene: the floor, the rover dropped over it.
-    new_item(&mut h, "scene");
-    type_into(&mut h, "name", "proving ground");
-    click(&mut h, "+ body");
-    click(&mut h, "floor");
-    click(&mut h, "+ robot");
-    click(&mut h, "rover");
-    assert!(h.state().overlaps().is_empty());
-    let start = body_origin(&h, "rover#0/chassis");
-    click(&mut h, "Play");
-    for _ in 0..600 {
-        h.run_steps(1);
-        if (body_origin(&h, "rover#0/chassis").x - start.x).abs() > 40.0 {
-            break;
-        }
-    }
-    let moved = body_origin(&h, "rover#0/chassis") - start;
-    assert!(moved.x.abs() > 40.0, "the rover drove: {moved}");
-    assert!(
-        h.state().sim().unwrap().metrics().max_joint_gap < 0.5,
-        "its pins hold"
-    );
-
-    h.key_press_modifiers(Modifiers::COMMAND, Key::S);
-    h.run_steps(2);
-    assert!(!h.state().db().is_dirty(), "saved: {}", h.state().status());
-    let built = h.state().model().clone();
-    let (reloaded, problems) = Database::load(dir.path());
-    assert!(problems.is_empty(), "{problems:#?}");
-    assert_eq!(
-        reloaded.model, built,
-        "everything comes back as it was built"
-    );
-    let h = harness(dir.path());
-    assert_eq!(*h.state().model(), built);
-    assert_eq!(
-        h.state().selection(),
-        Some(&Selection::Scene("proving ground".into()))
-    );
-}
-
 #[test]
 fn placements_copy_paste_and_turn_by_their_handle_and_the_view_exports_as_svg() {
     use robosim::app::files::{Answer, Scripted};
@@ -1024,6 +910,8 @@ mod chooser;
 mod drawing;
 #[path = "editor/export.rs"]
 mod export;
+#[path = "editor/new_user.rs"]
+mod new_user;
 #[path = "editor/running.rs"]
 mod running;
 #[path = "editor/selection.rs"]

@@ -11,7 +11,7 @@ use robosim::app::files::{Answer, Scripted};
 use robosim::db::Database;
 
 /// Replaces the text of the chooser's field showing `shown` (it has no label of its own).
-fn retype(h: &mut Harness<'_, RoboSimApp>, shown: &str, text: &str) {
+pub(super) fn retype(h: &mut Harness<'_, RoboSimApp>, shown: &str, text: &str) {
     let field = |n: &AccessKitNode<'_>| {
         n.role() == Role::TextInput
             && n.value().as_deref() == Some(shown)

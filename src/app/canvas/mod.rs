@@ -283,9 +283,7 @@ impl CanvasView {
             && drag_started
             && let Some(p) = pressed_screen
         {
-            let on_handle = self
-                .handle(sim, scene.followed, scene.picked)
-                .is_some_and(|h| h.distance(p) <= HANDLE_RADIUS + 4.0);
+            let on_handle = self.on_handle(scene, p);
             ui.ctx().data_mut(|d| d.insert_temp(turning_id, on_handle));
         }
         let turning = scene.editing && ui.ctx().data(|d| d.get_temp(turning_id).unwrap_or(false));
@@ -354,9 +352,11 @@ impl CanvasView {
         }
         let (camera, rect) = (self.camera, self.rect);
         if response.drag_started_by(PointerButton::Primary) {
-            let empty = ui
-                .input(|i| i.pointer.press_origin())
-                .filter(|&p| body_at(scene.sim, camera.to_world(rect, p), None).is_none());
+            // Empty canvas, the rotate handle aside: a drag from the handle turns.
+            let empty = ui.input(|i| i.pointer.press_origin()).filter(|&p| {
+                body_at(scene.sim, camera.to_world(rect, p), None).is_none()
+                    && !self.on_handle(scene, p)
+            });
             self.band = empty.map(|p| (p, p));
         }
         let Some((from, to)) = self.band.as_mut() else {
@@ -450,6 +450,12 @@ impl CanvasView {
             egui::FontId::proportional(13.0),
             BAND,
         );
+    }
+
+    /// Whether screen point `p` is on the rotate handle of the followed body.
+    fn on_handle(&self, scene: Scene<'_>, p: egui::Pos2) -> bool {
+        self.handle(scene.sim, scene.followed, scene.picked)
+            .is_some_and(|h| h.distance(p) <= HANDLE_RADIUS + 4.0)
     }
 
     /// Where the rotate handle of body `i` is on screen: above its outline.
