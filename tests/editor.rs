@@ -940,3 +940,29 @@ fn f1_and_esc_close_the_shortcut_sheet_and_help_opens_the_guide() {
             .is_some()
     );
 }
+
+/// The inspector keeps its width when a joint with a motor is opened (issue 64: the
+/// motor's direction said in words, "rear leg clockwise against body", widened it past
+/// the window's edge; an arrow says it now, the words on hover).
+#[test]
+fn the_inspector_keeps_its_width_when_a_joint_is_opened() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    h.get_by_label("walker · 3 bodies, 2 joints").click();
+    h.run_steps(3);
+    let canvas = h.state().canvas_rect().width();
+    for header in ["body – rear leg", "body – front leg"] {
+        h.get_by_label(header).click();
+        h.run_steps(3);
+    }
+    assert_eq!(
+        h.query_all_by_label("swing period").count(),
+        2,
+        "both motors shown"
+    );
+    assert_eq!(
+        h.state().canvas_rect().width(),
+        canvas,
+        "the canvas beside the inspector kept its width"
+    );
+}

@@ -160,7 +160,7 @@ pub fn body_motor_fields(
                     format!("{key} w"),
                     units.speed(ui, &mut m.angular).changed(),
                 );
-                ui.label(turn_arrow(m.angular, "", ""));
+                turn_arrow(ui, m.angular, "", "");
             });
             ui.end_row();
             ui.label("torque")
@@ -291,7 +291,7 @@ pub fn joint_fields(
                         format!("{key} mw"),
                         units.speed(ui, &mut m.angular).changed(),
                     );
-                    ui.label(turn_arrow(m.angular, &j.body_b, &j.body_a));
+                    turn_arrow(ui, m.angular, &j.body_b, &j.body_a);
                 });
                 ui.end_row();
                 ui.label("max torque").on_hover_text("The most torque the motor applies, on both bodies");
@@ -318,21 +318,24 @@ pub fn joint_fields(
         });
 }
 
-/// Which way a motor of speed `angular` turns `body` (relative to `other`, if any), as
-/// the canvas shows it (y down: a positive orientation turns clockwise on screen).
-pub fn turn_arrow(angular: f64, body: &str, other: &str) -> String {
-    let way = if angular > 0.0 {
-        "clockwise"
+/// An arrow for which way a motor of speed `angular` turns `body` (relative to `other`,
+/// if any) as the canvas shows it (y down: a positive orientation turns clockwise on
+/// screen), said in full when hovered. Short, so that the inspector keeps its width.
+pub fn turn_arrow(ui: &mut Ui, angular: f64, body: &str, other: &str) {
+    let (arrow, way) = if angular > 0.0 {
+        ("⟳", "clockwise")
     } else if angular < 0.0 {
-        "anticlockwise"
+        ("⟲", "anticlockwise")
     } else {
-        return "stands still".to_string();
+        ("·", "")
     };
-    if other.is_empty() {
-        format!("{way} on screen")
-    } else {
-        format!("{} {way} against {}", body.trim(), other.trim())
-    }
+    let said = match (way, other.is_empty()) {
+        ("", _) => "stands still".to_string(),
+        (way, true) => format!("turns {way} on screen"),
+        (way, false) => format!("{} turns {way} against {}", body.trim(), other.trim()),
+    };
+    ui.label(egui::RichText::new(arrow).size(16.0))
+        .on_hover_text(said);
 }
 
 /// Every motor's window on one time axis (steps).
