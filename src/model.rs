@@ -97,6 +97,23 @@ pub fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (f64, f64, f64
     )
 }
 
+/// A starting velocity (extension: attributes `vx`, `vy`, `omega`, default 0): of the
+/// placed point (a body's or a robot's origin) in length units per second, in the
+/// coordinates its x and y are given in, and the spin about it in rad/s (positive: the
+/// way a positive orientation turns).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StartVelocity {
+    pub vx: f64,
+    pub vy: f64,
+    pub omega: f64,
+}
+
+impl StartVelocity {
+    pub fn is_rest(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
 /// A body placed in a robot's frame: `<body alias source x y orientation>`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Placement {
@@ -107,6 +124,7 @@ pub struct Placement {
     pub x: f64,
     pub y: f64,
     pub orientation: f64,
+    pub velocity: StartVelocity,
     pub extra: ExtraAttributes,
     pub location: Location,
 }
@@ -166,13 +184,15 @@ impl Robot {
     }
 }
 
-/// A robot placed in a scene: `<robot source x y orientation>`.
+/// A robot placed in a scene: `<robot source x y orientation>`. Its starting velocity is
+/// the whole robot's, as one rigid body: its origin's velocity and the spin about it.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneRobot {
     pub source: String,
     pub x: f64,
     pub y: f64,
     pub orientation: f64,
+    pub velocity: StartVelocity,
     pub extra: ExtraAttributes,
     pub location: Location,
 }

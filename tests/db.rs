@@ -117,16 +117,26 @@ fn number() -> impl Strategy<Value = f64> {
 }
 
 fn placement() -> impl Strategy<Value = Placement> {
-    (name(), name(), number(), number(), number()).prop_map(|(alias, source, x, y, orientation)| {
-        Placement {
+    (name(), name(), number(), number(), number(), velocity()).prop_map(
+        |(alias, source, x, y, orientation, velocity)| Placement {
             alias,
             source,
             x,
             y,
             orientation,
+            velocity,
             ..Placement::default()
-        }
-    })
+        },
+    )
+}
+
+/// At rest half the time (no attributes written), else any numbers.
+fn velocity() -> impl Strategy<Value = robosim::model::StartVelocity> {
+    prop_oneof![
+        Just(robosim::model::StartVelocity::default()),
+        (number(), number(), number())
+            .prop_map(|(vx, vy, omega)| { robosim::model::StartVelocity { vx, vy, omega } }),
+    ]
 }
 
 fn model() -> impl Strategy<Value = Model> {
@@ -203,14 +213,16 @@ fn model() -> impl Strategy<Value = Model> {
             joints,
             ..Robot::default()
         });
-    let scene_robot =
-        (name(), number(), number(), number()).prop_map(|(source, x, y, orientation)| SceneRobot {
+    let scene_robot = (name(), number(), number(), number(), velocity()).prop_map(
+        |(source, x, y, orientation, velocity)| SceneRobot {
             source,
             x,
             y,
             orientation,
+            velocity,
             ..SceneRobot::default()
-        });
+        },
+    );
     let scene = (
         name(),
         number(),

@@ -536,3 +536,95 @@ fn the_walker_walks_the_car_drives_forward_and_the_housenka_crawls() {
     // Measured 2e-5 px: its pins stay closed while its motors swing.
     assert!(widest_gap < 1e-3, "its joints stay closed: {widest_gap} px");
 }
+
+/// Starting velocities (issue 65): a body placed with `vx`, `vy`, `omega` (its origin's
+/// velocity and the spin about it) in zero gravity moves exactly so; a robot placed with
+/// them moves as one rigid body, each body's own velocity added in the robot's frame.
+#[test]
+fn placed_velocities_start_bodies_and_robots_moving_as_given() {
+    use robosim::model::{BodyDef, Placement, Scene, SceneRobot, StartVelocity};
+    let mut model = model();
+    model.bodies.push(BodyDef {
+        name: "offset block".into(),
+        density: 1.0,
+        // Its centroid (20, 10) is off its origin: the origin's velocity is what is given.
+        vertices: vec![[0.0, 0.0], [40.0, 0.0], [40.0, 20.0], [0.0, 20.0]],
+        ..BodyDef::default()
+    });
+    let (vx, vy, omega) = (30.0, -20.0, 1.5);
+    let robot_velocity = StartVelocity {
+        vx: 50.0,
+        vy: 10.0,
+        omega: 0.5,
+    };
+    model.scenes.push(Scene {
+        name: "thrown".into(),
+        gravitation: 0.0,
+        timestep: Some(1.0 / 60.0),
+        bodies: vec![Placement {
+            alias: "block".into(),
+            source: "offset block".into(),
+            x: 100.0,
+            y: 200.0,
+            orientation: 0.3,
+            velocity: StartVelocity { vx, vy, omega },
+            ..Placement::default()
+        }],
+        robots: vec![SceneRobot {
+            source: "car".into(),
+            x: 600.0,
+            y: 200.0,
+            orientation: 0.7,
+            velocity: robot_velocity,
+            ..SceneRobot::default()
+        }],
+        ..Scene::default()
+    });
+    let mut sim = Simulation::new(&model, "thrown", None, None).unwrap();
+    let find = |sim: &Simulation, id: &str| {
+        let b = sim.bodies.iter().find(|b| b.id.contains(id)).unwrap();
+        sim.world.body(b.handle).unwrap().clone()
+    };
+    let block = find(&sim, "block");
+    let origin = block.origin();
+    let v0 = block.velocity_at(origin);
+    assert!((v0 - robosim::pe::Vec2::new(vx, vy)).norm() < 1e-12, "{v0}");
+    assert_eq!(block.angular_velocity, omega);
+    // Every body of the robot has the robot's velocity field: its origin's velocity and
+    // the spin about it (the robot's bodies have no velocity of their own).
+    let robot_origin = robosim::pe::Vec2::new(600.0, 200.0);
+    for b in sim.bodies.iter().filter(|b| b.id.starts_with("car#0")) {
+        let body = sim.world.body(b.handle).unwrap();
+        let v = body.velocity_at(robot_origin);
+        assert!(
+            (v - robosim::pe::Vec2::new(50.0, 10.0)).norm() < 1e-9,
+            "{}: {v}",
+            b.id
+        );
+        assert_eq!(body.angular_velocity, 0.5, "{}", b.id);
+    }
+    let (start, angle0, v_centroid) = (block.centroid(), block.angle, block.velocity);
+    let steps = 600;
+    for _ in 0..steps {
+        sim.try_step().unwrap();
+    }
+    let t = steps as f64 / 60.0;
+    let block = find(&sim, "block");
+    // Rounding only: 600 additions of h·v to a coordinate of a few hundred (measured
+    // 7e-13).
+    let drift = block.centroid() - (start + v_centroid * t);
+    assert!(
+        drift.norm() < 1e-11,
+        "the centroid moved straight on: {drift}"
+    );
+    assert_eq!(block.velocity, v_centroid);
+    assert!(
+        (block.angle - (angle0 + omega * t)).abs() < 1e-12,
+        "turned {} rad",
+        block.angle - angle0
+    );
+    assert!(
+        (block.velocity_at(block.origin()) - v0).norm() > 1.0,
+        "the origin circles the centroid"
+    );
+}

@@ -4,7 +4,8 @@
 use super::problem::Problem;
 use super::{FileKind, clip};
 use crate::model::{
-    BodyDef, BodyMotorDef, JointMotorDef, Model, Placement, Robot, Scene, SceneRobot, compose,
+    BodyDef, BodyMotorDef, JointMotorDef, Model, Placement, Robot, Scene, SceneRobot,
+    StartVelocity, compose,
 };
 use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
@@ -85,6 +86,15 @@ pub fn body_motor_problems(m: &BodyMotorDef) -> Vec<String> {
         );
     }
     out
+}
+
+/// A starting velocity's numbers beyond what the engine takes (`pe::limits`).
+fn velocity_beyond(v: &StartVelocity) -> Vec<String> {
+    beyond_all(&[
+        ("vx", v.vx, limits::SPEED),
+        ("vy", v.vy, limits::SPEED),
+        ("omega", v.omega, limits::SPIN),
+    ])
 }
 
 /// A joint motor's numbers: its speed per step and its torque.
@@ -231,7 +241,10 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
             ("x", p.x, limits::COORDINATE),
             ("y", p.y, limits::COORDINATE),
             ("orientation", p.orientation, limits::ANGLE),
-        ]) {
+        ])
+        .into_iter()
+        .chain(velocity_beyond(&p.velocity))
+        {
             out.push(Problem::error(file, &what, message).at(p.location));
         }
         if aliases.insert(p.alias.trim(), i).is_some() {
@@ -417,7 +430,10 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             ("x", r.x, limits::COORDINATE),
             ("y", r.y, limits::COORDINATE),
             ("orientation", r.orientation, limits::ANGLE),
-        ]) {
+        ])
+        .into_iter()
+        .chain(velocity_beyond(&r.velocity))
+        {
             out.push(Problem::error(file, &what, message).at(r.location));
         }
         if let Some(robot) = model.robot(&r.source) {
@@ -453,7 +469,10 @@ fn check_scene(model: &Model, scene: &Scene, file: &str, out: &mut Vec<Problem>)
             ("x", b.x, limits::COORDINATE),
             ("y", b.y, limits::COORDINATE),
             ("orientation", b.orientation, limits::ANGLE),
-        ]) {
+        ])
+        .into_iter()
+        .chain(velocity_beyond(&b.velocity))
+        {
             out.push(Problem::error(file, &what, message).at(b.location));
         }
         if aliases.insert(b.alias.trim(), ()).is_some() {

@@ -6,7 +6,7 @@ use super::problem::{FileProblems, Problem};
 use super::xml::{Element, clip};
 use crate::model::{
     BodyDef, BodyMotorDef, ExtraAttributes, JointDef, JointMotorDef, Placement, Robot, RobotBody,
-    Scene, SceneRobot,
+    Scene, SceneRobot, StartVelocity,
 };
 
 /// What reading a file gave: its records, the problems, and whether any record was
@@ -250,6 +250,11 @@ fn placement(
         y: f.number("y"),
         // The thesis always writes it; files from elsewhere may not: 0 is the natural default.
         orientation: f.optional_number("orientation").unwrap_or(0.0),
+        velocity: StartVelocity {
+            vx: f.optional_number("vx").unwrap_or(0.0),
+            vy: f.optional_number("vy").unwrap_or(0.0),
+            omega: f.optional_number("omega").unwrap_or(0.0),
+        },
         extra: f.extra(),
         location: el.location,
     };
@@ -406,6 +411,7 @@ pub fn scenes(root: &Element, file: &str) -> Read<Scene> {
                         x: p.x,
                         y: p.y,
                         orientation: p.orientation,
+                        velocity: p.velocity,
                         extra: p.extra,
                         location: p.location,
                     });

@@ -1,7 +1,7 @@
 //! Model records back to the three files' text, in the element and attribute names of
 //! thesis §4.3; extensions only where a record uses them, unknown attributes kept.
 
-use crate::model::{BodyDef, ExtraAttributes, Robot, Scene};
+use crate::model::{BodyDef, ExtraAttributes, Robot, Scene, StartVelocity};
 use quick_xml::escape::escape;
 use std::fmt::Write;
 
@@ -47,6 +47,14 @@ impl Tag {
 
     fn num(self, key: &str, value: f64) -> Self {
         self.text(key, &number(value))
+    }
+
+    /// The starting velocity's attributes that are not 0 (a placement at rest has none).
+    fn velocity(self, v: &StartVelocity) -> Self {
+        [("vx", v.vx), ("vy", v.vy), ("omega", v.omega)]
+            .into_iter()
+            .filter(|&(_, value)| value != 0.0)
+            .fold(self, |tag, (key, value)| tag.num(key, value))
     }
 
     fn extra(mut self, extra: &ExtraAttributes) -> Self {
@@ -139,6 +147,7 @@ pub fn robot(r: &Robot, out: &mut String) {
             .num("x", p.x)
             .num("y", p.y)
             .num("orientation", p.orientation)
+            .velocity(&p.velocity)
             .extra(&p.extra);
         if b.motors.is_empty() {
             tag.empty(out);
@@ -207,6 +216,7 @@ pub fn scene(s: &Scene, out: &mut String) {
             .num("x", r.x)
             .num("y", r.y)
             .num("orientation", r.orientation)
+            .velocity(&r.velocity)
             .extra(&r.extra)
             .empty(out);
     }
@@ -217,6 +227,7 @@ pub fn scene(s: &Scene, out: &mut String) {
             .num("x", b.x)
             .num("y", b.y)
             .num("orientation", b.orientation)
+            .velocity(&b.velocity)
             .extra(&b.extra)
             .empty(out);
     }

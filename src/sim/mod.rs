@@ -122,6 +122,23 @@ fn compose(frame: (f64, f64, f64), local: (f64, f64, f64)) -> (Vec2, f64) {
     (Vec2::new(x, y), angle)
 }
 
+/// The world velocity of a robot body's origin at `origin` and its spin: the robot's
+/// motion as one rigid body (its origin's velocity, its spin about that origin) plus the
+/// body's own starting velocity, given in the robot's coordinates.
+fn robot_body_velocity(robot: &SceneRobot, body: &Placement, origin: Vec2) -> (Vec2, f64) {
+    let (rv, bv) = (&robot.velocity, &body.velocity);
+    let arm = origin - Vec2::new(robot.x, robot.y);
+    let carried = Vec2::new(rv.vx - rv.omega * arm.y, rv.vy + rv.omega * arm.x);
+    let own = rotated(Vec2::new(bv.vx, bv.vy), robot.orientation);
+    (carried + own, rv.omega + bv.omega)
+}
+
+/// `v` turned by `angle` (radians), as `model::compose` turns a placement.
+fn rotated(v: Vec2, angle: f64) -> Vec2 {
+    let (x, y, _) = crate::model::compose((0.0, 0.0, angle), (v.x, v.y, 0.0));
+    Vec2::new(x, y)
+}
+
 fn placement_frame(p: &Placement) -> (f64, f64, f64) {
     (p.x, p.y, p.orientation)
 }
@@ -166,12 +183,15 @@ impl Simulation {
         Ok(sim)
     }
 
+    /// Body `placement` with its origin at `at` (world point and angle), the origin moving
+    /// at `moving` (world velocity and spin about it).
     fn add_body(
         &mut self,
         id: String,
         placed_by: PlacedBy,
         placement: &Placement,
         at: (Vec2, f64),
+        moving: (Vec2, f64),
     ) -> Result<BodyHandle, String> {
         let def = self
             .model
@@ -179,9 +199,16 @@ impl Simulation {
             .ok_or_else(|| format!("{id}: source \"{}\" is not a body", placement.source))?;
         let polygon = db::polygon(def).map_err(|e| format!("{id}: body \"{}\": {e}", def.name))?;
         // Density, friction and placement are checked by `pe` (its limits, its words).
+        // pe takes the centroid's velocity: the origin's, plus the spin about the origin.
+        let to_centroid = rotated(polygon.mass_properties().centroid, at.1);
+        let (v_origin, spin) = moving;
+        let v_centroid = v_origin + Vec2::new(-spin * to_centroid.y, spin * to_centroid.x);
         let mut body = BodyDef::new(polygon, def.density)
             .restitution(def.cor)
             .at(at.0, at.1);
+        if def.density > 0.0 {
+            body = body.velocity(v_centroid, spin);
+        }
         if let Some(mu) = def.friction {
             body = body.friction(mu);
         }
@@ -215,7 +242,9 @@ impl Simulation {
         }
         for (k, p) in scene.bodies.iter().enumerate() {
             let at = (Vec2::new(p.x, p.y), p.orientation);
-            self.add_body(p.alias.clone(), PlacedBy::SceneBody(k), p, at)?;
+            let v = &p.velocity;
+            let moving = (Vec2::new(v.vx, v.vy), v.omega);
+            self.add_body(p.alias.clone(), PlacedBy::SceneBody(k), p, at, moving)?;
         }
         // Scenes are in pixels, tens of units per body, not metres: tolerances scale with
         // the typical body.
@@ -235,8 +264,9 @@ impl Simulation {
             let p = &b.placement;
             let id = format!("{prefix}/{}", p.alias);
             let placed_by = PlacedBy::RobotBody { robot: i, body: k };
-            let handle =
-                self.add_body(id.clone(), placed_by, p, compose(frame, placement_frame(p)))?;
+            let at = compose(frame, placement_frame(p));
+            let moving = robot_body_velocity(placed, p, at.0);
+            let handle = self.add_body(id.clone(), placed_by, p, at, moving)?;
             for m in &b.motors {
                 self.add_body_motor(&id, handle, m)?;
             }

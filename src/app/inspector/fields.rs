@@ -125,6 +125,21 @@ pub fn placement_fields(
                 .changed(),
             );
             ui.end_row();
+            ui.label("start velocity").on_hover_text(
+                "How fast the placed origin moves at step 0 (units/s, in the parent's axes, y down) and its spin about the origin (rad/s, positive clockwise on screen); a robot's moves it as one rigid body",
+            );
+            ui.horizontal(|ui| {
+                let v = &mut p.velocity;
+                for (name, value, suffix) in [("vx", &mut v.vx, ""), ("vy", &mut v.vy, ""), ("omega", &mut v.omega, " rad/s")] {
+                    edit.touched(
+                        format!("{key} {name}"),
+                        ui.add(DragValue::new(value).speed(1.0).suffix(suffix))
+                            .on_hover_text(name)
+                            .changed(),
+                    );
+                }
+            });
+            ui.end_row();
         });
 }
 

@@ -109,10 +109,12 @@ fn robots(ui: &mut Ui, scene: &mut Scene, robot_names: &[String], edit: &mut Edi
                     x: r.x,
                     y: r.y,
                     orientation: r.orientation,
+                    velocity: r.velocity,
                     ..Placement::default()
                 };
                 placement_fields(ui, &mut p, robot_names, false, &format!("r{i}"), edit);
-                (r.source, r.x, r.y, r.orientation) = (p.source, p.x, p.y, p.orientation);
+                (r.source, r.x, r.y, r.orientation, r.velocity) =
+                    (p.source, p.x, p.y, p.orientation, p.velocity);
                 if ui.button("Remove robot").clicked() {
                     remove = Some(i);
                 }
