@@ -350,13 +350,7 @@ fn a_motor_switched_off_or_removed_stops_driving_its_joint() {
             let bar = ConvexPolygon::rectangle(2.0, 0.2).unwrap();
             let bar = w.add_body(BodyDef::new(bar, 1.0)).unwrap();
             let mut pin = JointDef::new(bar, None, Vec2::zeros());
-            pin.motor = Some(JointMotor {
-                target_speed: 5.0,
-                max_torque: 0.05,
-                enabled: true,
-                last_impulse: 0.0,
-                step_impulse: 0.0,
-            });
+            pin.motor = Some(JointMotor::new(5.0, 0.05));
             let pin = w.add_joint(pin).unwrap();
             for _ in 0..30 {
                 w.step(H);

@@ -30,6 +30,95 @@ pub struct Joint {
     /// parts overlap around their pins, thesis §3.1).
     pub collide_connected: bool,
     pub motor: Option<JointMotor>,
+    /// The relative angle angle_B − angle_A (angle_B = 0 for the world) when the joint was
+    /// made: the joint's angle θ counts from it, so that θ = 0 as placed.
+    pub reference_angle: f64,
+    pub spring: Option<JointSpring>,
+}
+
+/// A rotational spring-damper across a joint: torque on body B
+/// −stiffness·(θ − rest_angle) − damping·(ω_B − ω_A), the opposite on A.
+///
+/// The step applies it as a torque pair before the constraints are solved: explicitly in
+/// its stiffness where the step resolves the spring ((ω h)² ≤ 1 for the pair's ω² =
+/// stiffness·(1/I_A + 1/I_B)): symplectic, so an undamped spring keeps its energy and its
+/// period; implicitly beyond that, so that a spring however stiff stays stable (it then
+/// loses energy it cannot show). Damping is always implicit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointSpring {
+    /// Torque per radian, ≥ 0.
+    pub stiffness: f64,
+    /// Torque per rad/s, ≥ 0.
+    pub damping: f64,
+    pub rest_angle: f64,
+}
+
+impl JointSpring {
+    pub fn new(stiffness: f64, damping: f64, rest_angle: f64) -> Self {
+        Self {
+            stiffness,
+            damping,
+            rest_angle,
+        }
+    }
+
+    /// The angular impulse the spring puts on body B over a step of `dt` (−it on A),
+    /// given the joint's angle θ, the relative spin ω_B − ω_A and the pair's summed
+    /// inverse inertia. `implicit_share` β of the stiffness acts on the angle at the
+    /// step's end: a solver whose positions take the fraction p of the step's change of
+    /// velocity keeps an undamped spring's energy with β = 1 − p (0 where the kick comes
+    /// before the drift, as in symplectic Euler). A spring the step cannot resolve
+    /// ((ω h)² > 1) is wholly implicit.
+    pub(crate) fn impulse(
+        &self,
+        theta: f64,
+        relative_spin: f64,
+        inv_inertia: f64,
+        dt: f64,
+        implicit_share: f64,
+    ) -> f64 {
+        let (k, c, m) = (self.stiffness, self.damping, inv_inertia);
+        if m <= 0.0 {
+            return 0.0;
+        }
+        let share = if dt * dt * k * m <= 1.0 {
+            implicit_share
+        } else {
+            1.0
+        };
+        // ω' = ω + m·J with J = −dt·(k·(θ − rest + β·h·ω') + c·ω'), solved for ω'.
+        let spin_after = (relative_spin - m * dt * k * (theta - self.rest_angle))
+            / (1.0 + m * dt * (c + share * dt * k));
+        (spin_after - relative_spin) / m
+    }
+
+    /// Both numbers finite, non-negative and within `crate::limits`, the rest angle finite.
+    pub(crate) fn validate(&self) -> Result<(), super::motor::MotorError> {
+        use super::motor::MotorError;
+        for (what, value) in [
+            ("stiffness", self.stiffness),
+            ("damping", self.damping),
+            ("rest angle", self.rest_angle),
+        ] {
+            if !value.is_finite() {
+                return Err(MotorError::NonFinite(what, value));
+            }
+        }
+        for (what, value) in [("stiffness", self.stiffness), ("damping", self.damping)] {
+            if value < 0.0 {
+                return Err(MotorError::Negative(what, value));
+            }
+        }
+        let numbers = [
+            ("stiffness", self.stiffness, crate::limits::TORQUE),
+            ("damping", self.damping, crate::limits::TORQUE),
+            ("rest angle", self.rest_angle, crate::limits::ANGLE),
+        ];
+        if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
+            return Err(MotorError::Beyond(what, value, limit));
+        }
+        Ok(())
+    }
 }
 
 /// A joint as the solver sees it: body slots in the step's solver array (the static world
@@ -62,6 +151,14 @@ pub struct JointMotor {
     /// Angular impulse the motor applied over the whole last step, all substeps summed:
     /// the mean torque of the step is `step_impulse / h`.
     pub step_impulse: f64,
+    /// A servo: drives the joint's angle θ (see [`Joint::reference_angle`]) to this, at no
+    /// more than |target_speed| and with at most `max_torque`, and holds it there. Each
+    /// step the world asks for the relative spin that reaches the target by the step's
+    /// end, (target − θ)/h, capped at |target_speed| (`drive_speed`).
+    pub target_angle: Option<f64>,
+    /// The servo's spin for this step (ω_A − ω_B, as `target_speed`): the world sets it
+    /// at the start of every step; what is written here is overwritten.
+    pub servo_speed: f64,
 }
 
 impl JointMotor {
@@ -77,9 +174,19 @@ impl JointMotor {
         if self.max_torque < 0.0 {
             return Err(MotorError::Negative("max torque", self.max_torque));
         }
+        if let Some(angle) = self.target_angle
+            && !angle.is_finite()
+        {
+            return Err(MotorError::NonFinite("target angle", angle));
+        }
         let numbers = [
             ("target speed", self.target_speed, crate::limits::SPIN),
             ("max torque", self.max_torque, crate::limits::TORQUE),
+            (
+                "target angle",
+                self.target_angle.unwrap_or(0.0),
+                crate::limits::ANGLE,
+            ),
         ];
         if let Some((what, value, limit)) = crate::limits::first_beyond(numbers) {
             return Err(MotorError::Beyond(what, value, limit));
@@ -94,6 +201,35 @@ impl JointMotor {
             enabled: true,
             last_impulse: 0.0,
             step_impulse: 0.0,
+            target_angle: None,
+            servo_speed: 0.0,
+        }
+    }
+
+    /// A servo to `target_angle` (radians of θ) at no more than `max_speed` (rad/s).
+    pub fn servo(target_angle: f64, max_speed: f64, max_torque: f64) -> Self {
+        Self {
+            target_angle: Some(target_angle),
+            ..Self::new(max_speed.abs(), max_torque)
+        }
+    }
+
+    /// The relative spin ω_A − ω_B the solvers drive this step: `target_speed`, or a
+    /// servo's speed towards its angle.
+    pub fn drive_speed(&self) -> f64 {
+        match self.target_angle {
+            Some(_) => self.servo_speed,
+            None => self.target_speed,
+        }
+    }
+
+    /// Sets a servo's speed for a step of `dt` at joint angle `theta`: the spin that
+    /// reaches the target by the step's end, within ±|target_speed|. θ grows with
+    /// ω_B − ω_A, the negative of what the motor drives.
+    pub(crate) fn aim(&mut self, theta: f64, dt: f64) {
+        if let Some(target) = self.target_angle {
+            let cap = self.target_speed.abs();
+            self.servo_speed = -((target - theta) / dt).clamp(-cap, cap);
         }
     }
 }

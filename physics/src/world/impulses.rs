@@ -53,6 +53,7 @@ impl World {
             self.stats.impulse_substeps += substeps as u64;
             for _ in 0..substeps {
                 self.correct_joint_velocities(h);
+                self.kick_joint_springs(h);
                 self.integrate_velocities(h);
                 self.detect_contacts(h, Pipeline::Impulses);
                 self.push_apart(method);

@@ -20,6 +20,65 @@ impl World {
         }
     }
 
+    /// Each joint spring's angular impulse over `dt` (`JointSpring::impulse`, with
+    /// `implicit_share`), handed to `apply` with each body this pass moves: + on body B,
+    /// − on body A.
+    fn joint_spring_impulses(
+        &mut self,
+        dt: f64,
+        implicit_share: f64,
+        mut apply: impl FnMut(&mut Body, f64),
+    ) {
+        for k in 0..self.joints.len() {
+            let Some(joint) = self.joints[k] else {
+                continue;
+            };
+            let Some(spring) = joint.spring else {
+                continue;
+            };
+            let moving = |h: Option<crate::body::BodyHandle>| {
+                let h = h?;
+                let b = self.bodies.get(h.index())?.as_ref()?;
+                (!self.sets.fixed_in_pass(h.0, b)).then_some((b.angular_velocity, b.inv_inertia))
+            };
+            let (a, b) = (moving(Some(joint.body_a)), moving(joint.body_b));
+            if a.is_none() && b.is_none() {
+                continue;
+            }
+            let Some(theta) = self.joint_angle(crate::JointHandle(k as u32)) else {
+                continue;
+            };
+            let spin = |side: Option<(f64, f64)>| side.map_or(0.0, |s| s.0);
+            let inverse = |side: Option<(f64, f64)>| side.map_or(0.0, |s| s.1);
+            let impulse = spring.impulse(
+                theta,
+                spin(b) - spin(a),
+                inverse(a) + inverse(b),
+                dt,
+                implicit_share,
+            );
+            if a.is_some()
+                && let Some(Some(body)) = self.bodies.get_mut(joint.body_a.index())
+            {
+                apply(body, -impulse);
+            }
+            if b.is_some()
+                && let Some(h) = joint.body_b
+                && let Some(Some(body)) = self.bodies.get_mut(h.index())
+            {
+                apply(body, impulse);
+            }
+        }
+    }
+
+    /// Joint springs change spins at once, before a (sub)step's velocities are
+    /// integrated: a kick before the drift, symplectic (see `JointSpring::impulse`).
+    pub(super) fn kick_joint_springs(&mut self, dt: f64) {
+        self.joint_spring_impulses(dt, 0.0, |body, impulse| {
+            body.angular_velocity += impulse * body.inv_inertia;
+        });
+    }
+
     /// Gravity and accumulated forces change velocities (thesis §3.4 steps 2–3).
     /// (Every body's velocity is kept in `start_velocities` first, for restitution: the
     /// awake bodies' each time, the others' when the sets change.)

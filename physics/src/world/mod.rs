@@ -35,7 +35,7 @@ use crate::solver::contact::Contact;
 use crate::solver::exact::SimultaneousSolver;
 use crate::solver::exact::joint_block::JointBlockSolver;
 use crate::solver::impacts::ImpactPass;
-use crate::solver::joint::{Joint, JointConstraint, JointHandle, JointMotor};
+use crate::solver::joint::{Joint, JointConstraint, JointHandle, JointMotor, JointSpring};
 use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::report::{IslandReport, StepStats};
 use crate::solver::soft::SoftStepSolver;
@@ -78,6 +78,7 @@ pub struct JointDef {
     pub anchor: Vec2,
     pub collide_connected: bool,
     pub motor: Option<JointMotor>,
+    pub spring: Option<JointSpring>,
 }
 
 impl JointDef {
@@ -90,6 +91,7 @@ impl JointDef {
             anchor,
             collide_connected: false,
             motor: None,
+            spring: None,
         }
     }
 }
@@ -397,14 +399,18 @@ impl World {
         if let Some(m) = &def.motor {
             m.validate().map_err(JointError::BadMotor)?;
         }
+        if let Some(s) = &def.spring {
+            s.validate().map_err(JointError::BadMotor)?;
+        }
         let a = self.body(def.body_a).ok_or(JointError::MissingBody)?;
         let local_anchor_a = a.to_local(def.anchor);
-        let local_anchor_b = match def.body_b {
-            Some(h) => self
-                .body(h)
-                .ok_or(JointError::MissingBody)?
-                .to_local(def.anchor),
-            None => def.anchor,
+        let angle_a = a.angle;
+        let (local_anchor_b, angle_b) = match def.body_b {
+            Some(h) => {
+                let b = self.body(h).ok_or(JointError::MissingBody)?;
+                (b.to_local(def.anchor), b.angle)
+            }
+            None => (def.anchor, 0.0),
         };
         self.joints.push(Some(Joint {
             body_a: def.body_a,
@@ -413,6 +419,8 @@ impl World {
             local_anchor_b,
             collide_connected: def.collide_connected,
             motor: def.motor,
+            reference_angle: angle_b - angle_a,
+            spring: def.spring,
         }));
         self.collision_filter_stale = true;
         Ok(JointHandle((self.joints.len() - 1) as u32))
@@ -636,6 +644,7 @@ impl World {
             return Err(StepError::FallsTooFar { fall, limit });
         }
         self.check_motor_speeds(dt)?;
+        self.aim_servos(dt);
         if self.bodies_handed_out {
             self.check_bodies_given()?;
             self.bodies_handed_out = false;
@@ -658,6 +667,35 @@ impl World {
             self.check_pins_held()?;
         }
         self.check_state()
+    }
+
+    /// A joint's angle θ: (angle_B − angle_A) less the same difference as the joint was
+    /// made (angle_B = 0 for the world), so θ = 0 as placed and grows with ω_B − ω_A.
+    pub fn joint_angle(&self, handle: JointHandle) -> Option<f64> {
+        let j = self.joint(handle)?;
+        let angle_a = self.body(j.body_a)?.angle;
+        let angle_b = match j.body_b {
+            Some(h) => self.body(h)?.angle,
+            None => 0.0,
+        };
+        Some(angle_b - angle_a - j.reference_angle)
+    }
+
+    /// Each servo's speed for this step, from its joint's angle now.
+    fn aim_servos(&mut self, dt: f64) {
+        for k in 0..self.joints.len() {
+            let servo =
+                self.joints[k].is_some_and(|j| j.motor.is_some_and(|m| m.target_angle.is_some()));
+            if !servo {
+                continue;
+            }
+            let theta = self.joint_angle(JointHandle(k as u32));
+            if let (Some(theta), Some(Some(j))) = (theta, self.joints.get_mut(k))
+                && let Some(m) = j.motor.as_mut()
+            {
+                m.aim(theta, dt);
+            }
+        }
     }
 
     /// Every joint motor's numbers are ones it may have, and every enabled one asks for

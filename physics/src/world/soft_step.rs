@@ -41,6 +41,8 @@ impl World {
     /// that integrate and solve together (see `solver::soft`).
     pub(super) fn step_soft(&mut self, dt: f64) {
         self.inputs.start_velocities.clear(); // forces act inside the substeps
+        // Joint springs kick before the substeps drift: symplectic over the whole step.
+        self.kick_joint_springs(dt);
         self.detect_contacts(dt, Pipeline::Soft);
         // The soft step pulls every pin closed its own way: no repair targets.
         self.gather_solver_bodies_with(GapTargets::None);

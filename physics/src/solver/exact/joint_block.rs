@@ -85,7 +85,7 @@ fn drive_motors_continue(
             let relative = bodies[ia].angular_velocity - bodies[ib].angular_velocity;
             let limit = motor.max_torque * dt;
             let total = clamp(
-                motor.last_impulse - (relative - motor.target_speed) / k,
+                motor.last_impulse - (relative - motor.drive_speed()) / k,
                 -limit,
                 limit,
             );

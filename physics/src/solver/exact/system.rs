@@ -229,7 +229,7 @@ pub(crate) fn velocity_rows(
                 hi: limit,
                 friction_of: None,
             };
-            row.b = row.velocity(bodies) - m.target_speed;
+            row.b = row.velocity(bodies) - m.drive_speed();
             rows.push(row);
         }
     }

@@ -75,7 +75,7 @@ impl SoftPins {
             let motor = j
                 .motor
                 .filter(|m| m.enabled)
-                .map(|m| (m.target_speed, m.max_torque));
+                .map(|m| (m.drive_speed(), m.max_torque));
             self.joints.push(SoftJoint {
                 a: j.body_a,
                 b: j.body_b,
