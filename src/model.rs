@@ -64,6 +64,10 @@ pub struct JointMotorDef {
     /// first half of every `period` steps from time0 and at −angular for the second half,
     /// so that its joint swings to and fro through angular·period/2: a gait.
     pub period: u64,
+    /// Extension (attribute `targetAngle`, radians): a servo, driving the joint's angle θ
+    /// (θ = 0 as placed) to this at no more than |angular| a step, with at most
+    /// maxTorque, and holding it there.
+    pub target_angle: Option<f64>,
     pub extra: ExtraAttributes,
     pub location: Location,
 }
@@ -145,9 +149,24 @@ pub struct JointDef {
     pub anchor_ay: f64,
     /// Extension (attribute `collide`): the two bodies also collide with each other.
     pub collide: bool,
+    /// Extension (attributes `stiffness`, `damping`, `restAngle`, default 0): a rotational
+    /// spring-damper across the joint, torque on B −stiffness·(θ − restAngle) −
+    /// damping·(ω_B − ω_A), θ = 0 as placed. None without stiffness or damping.
+    pub spring: Option<JointSpringDef>,
     pub motor: Option<JointMotorDef>,
     pub extra: ExtraAttributes,
     pub location: Location,
+}
+
+/// A joint's rotational spring-damper (see `JointDef::spring`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JointSpringDef {
+    /// Torque per radian.
+    pub stiffness: f64,
+    /// Torque per rad/s.
+    pub damping: f64,
+    /// Radians of θ at which the spring is slack.
+    pub rest_angle: f64,
 }
 
 impl JointDef {

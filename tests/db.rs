@@ -189,14 +189,22 @@ fn model() -> impl Strategy<Value = Model> {
         number(),
         any::<bool>(),
         prop::option::of(joint_motor),
+        prop::option::of((number(), number(), number())),
     )
-        .prop_map(|(a, b, ax, ay, collide, motor)| JointDef {
+        .prop_map(|(a, b, ax, ay, collide, motor, spring)| JointDef {
             body_a: a,
             body_b: b,
             anchor_ax: ax,
             anchor_ay: ay,
             collide,
             motor,
+            spring: spring.map(
+                |(stiffness, damping, rest_angle)| robosim::model::JointSpringDef {
+                    stiffness,
+                    damping,
+                    rest_angle,
+                },
+            ),
             ..JointDef::default()
         });
     let robot = (

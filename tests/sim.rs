@@ -628,3 +628,71 @@ fn placed_velocities_start_bodies_and_robots_moving_as_given() {
         "the origin circles the centroid"
     );
 }
+
+/// Springs and servos through the files (issue 65): a `<joint>` with `stiffness` and a
+/// `<motor>` with `targetAngle` reach the engine; `check` refuses a negative stiffness.
+#[test]
+fn joint_springs_and_servos_from_the_files_move_the_joint() {
+    use robosim::model::{JointMotorDef, JointSpringDef, Scene, SceneRobot};
+    let mut model = model();
+    let mut arm = model.robot("double pendulum").unwrap().clone();
+    arm.name = "servo arm".into();
+    model.robots.push(arm);
+    model.scenes.push(Scene {
+        name: "servo".into(),
+        gravitation: 0.0,
+        timestep: Some(1.0 / 60.0),
+        robots: vec![SceneRobot {
+            source: "servo arm".into(),
+            x: 400.0,
+            y: 100.0,
+            ..SceneRobot::default()
+        }],
+        ..Scene::default()
+    });
+    fn robot(m: &mut robosim::model::Model) -> &mut robosim::model::Robot {
+        m.robots.iter_mut().find(|r| r.name == "servo arm").unwrap()
+    }
+    // The first joint a servo to 1 rad at 0.05 rad a step; the second a spring.
+    robot(&mut model).joints[0].motor = Some(JointMotorDef {
+        time0: 0,
+        time1: 100_000,
+        angular: 0.05,
+        max_torque: 1e12,
+        target_angle: Some(1.0),
+        ..JointMotorDef::default()
+    });
+    robot(&mut model).joints[1].spring = Some(JointSpringDef {
+        stiffness: 1e6,
+        damping: 0.0,
+        rest_angle: 0.5,
+    });
+    let mut sim = Simulation::new(&model, "servo", None, None).unwrap();
+    let (servo, spring) = (sim.joints[0].handle, sim.joints[1].handle);
+    let mut spring_moved: f64 = 0.0;
+    for _ in 0..120 {
+        sim.try_step().unwrap();
+        spring_moved = spring_moved.max(sim.world.joint_angle(spring).unwrap().abs());
+    }
+    let held = sim.world.joint_angle(servo).unwrap();
+    assert!((held - 1.0).abs() < 0.01, "the servo holds 1 rad: {held}");
+    assert!(
+        spring_moved > 0.1,
+        "the spring turned its joint: {spring_moved}"
+    );
+
+    robot(&mut model).joints[1]
+        .spring
+        .as_mut()
+        .unwrap()
+        .stiffness = -5.0;
+    let problems = robosim::db::check(&model, |k| format!("{k:?}.xml"));
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.to_string().contains("stiffness -5 must be ≥ 0")),
+        "{problems:#?}"
+    );
+    let refused = Simulation::new(&model, "servo", None, None).err().unwrap();
+    assert!(refused.to_string().contains("stiffness"), "{refused}");
+}

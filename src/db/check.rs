@@ -4,8 +4,8 @@
 use super::problem::Problem;
 use super::{FileKind, clip};
 use crate::model::{
-    BodyDef, BodyMotorDef, JointMotorDef, Model, Placement, Robot, Scene, SceneRobot,
-    StartVelocity, compose,
+    BodyDef, BodyMotorDef, JointMotorDef, JointSpringDef, Model, Placement, Robot, Scene,
+    SceneRobot, StartVelocity, compose,
 };
 use pe::{ContactSolver, ConvexPolygon, Vec2};
 use std::collections::BTreeMap;
@@ -97,6 +97,22 @@ fn velocity_beyond(v: &StartVelocity) -> Vec<String> {
     ])
 }
 
+/// A joint spring's numbers: stiffness and damping ≥ 0, all within `pe::limits`.
+pub fn joint_spring_problems(s: &JointSpringDef) -> Vec<String> {
+    let mut out = Vec::new();
+    for (what, value) in [("stiffness", s.stiffness), ("damping", s.damping)] {
+        if value < 0.0 {
+            out.push(format!("{what} {value} must be ≥ 0"));
+        }
+    }
+    out.extend(beyond_all(&[
+        ("stiffness", s.stiffness, limits::TORQUE),
+        ("damping", s.damping, limits::TORQUE),
+        ("restAngle", s.rest_angle, limits::ANGLE),
+    ]));
+    out
+}
+
 /// A joint motor's numbers: its speed per step and its torque.
 pub fn joint_motor_problems(m: &JointMotorDef) -> Vec<String> {
     let mut out = Vec::new();
@@ -106,6 +122,16 @@ pub fn joint_motor_problems(m: &JointMotorDef) -> Vec<String> {
     if m.period == 1 {
         out.push("period 1 has no second half to turn back in: use 2 or more".to_string());
     }
+    if m.period > 0 && m.target_angle.is_some() {
+        out.push(
+            "a servo (targetAngle) holds its angle: it cannot also swing (period)".to_string(),
+        );
+    }
+    out.extend(beyond_all(&[(
+        "targetAngle",
+        m.target_angle.unwrap_or(0.0),
+        limits::ANGLE,
+    )]));
     out.extend(beyond_all(&[
         ("angular", m.angular, limits::ANGULAR),
         ("maxTorque", m.max_torque, limits::TORQUE),
@@ -303,6 +329,11 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                     )
                     .at(j.location),
                 );
+            }
+        }
+        if let Some(spring) = &j.spring {
+            for message in joint_spring_problems(spring) {
+                out.push(Problem::error(file, &what, message).at(j.location));
             }
         }
         if let Some(m) = &j.motor {

@@ -5,8 +5,8 @@
 use super::problem::{FileProblems, Problem};
 use super::xml::{Element, clip};
 use crate::model::{
-    BodyDef, BodyMotorDef, ExtraAttributes, JointDef, JointMotorDef, Placement, Robot, RobotBody,
-    Scene, SceneRobot, StartVelocity,
+    BodyDef, BodyMotorDef, ExtraAttributes, JointDef, JointMotorDef, JointSpringDef, Placement,
+    Robot, RobotBody, Scene, SceneRobot, StartVelocity,
 };
 
 /// What reading a file gave: its records, the problems, and whether any record was
@@ -324,10 +324,21 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
                         anchor_ax: f.number("anchorAx"),
                         anchor_ay: f.number("anchorAy"),
                         collide: f.flag("collide"),
+                        spring: None,
                         motor: None,
                         extra: Vec::new(),
                         location: child.location,
                     };
+                    let (stiffness, damping) =
+                        (f.optional_number("stiffness"), f.optional_number("damping"));
+                    let rest_angle = f.optional_number("restAngle");
+                    if stiffness.is_some() || damping.is_some() || rest_angle.is_some() {
+                        joint.spring = Some(JointSpringDef {
+                            stiffness: stiffness.unwrap_or(0.0),
+                            damping: damping.unwrap_or(0.0),
+                            rest_angle: rest_angle.unwrap_or(0.0),
+                        });
+                    }
                     joint.extra = f.extra();
                     failed |= f.failed;
                     for m in &child.children {
@@ -343,6 +354,7 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
                             angular: f.number("angular"),
                             max_torque: f.number("maxTorque"),
                             period: f.optional_steps("period").unwrap_or(0),
+                            target_angle: f.optional_number("targetAngle"),
                             extra: Vec::new(),
                             location: m.location,
                         };

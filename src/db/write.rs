@@ -176,6 +176,12 @@ pub fn robot(r: &Robot, out: &mut String) {
         if j.collide {
             tag = tag.text("collide", "true");
         }
+        if let Some(spring) = &j.spring {
+            tag = tag
+                .num("stiffness", spring.stiffness)
+                .num("damping", spring.damping)
+                .num("restAngle", spring.rest_angle);
+        }
         let tag = tag.extra(&j.extra);
         match &j.motor {
             None => tag.empty(out),
@@ -188,6 +194,9 @@ pub fn robot(r: &Robot, out: &mut String) {
                     .num("maxTorque", m.max_torque);
                 if m.period > 0 {
                     motor = motor.num("period", m.period as f64);
+                }
+                if let Some(angle) = m.target_angle {
+                    motor = motor.num("targetAngle", angle);
                 }
                 motor.extra(&m.extra).empty(out);
                 out.push_str("    </joint>\n");

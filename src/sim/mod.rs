@@ -334,12 +334,23 @@ impl Simulation {
     ) -> Result<(), String> {
         let mut def = pe::JointDef::new(a, Some(b), anchor);
         def.collide_connected = joint.collide;
+        if let Some(spring) = &joint.spring {
+            if let Some(problem) = db::joint_spring_problems(spring).into_iter().next() {
+                return Err(format!("{id}: spring: {problem}"));
+            }
+            def.spring = Some(pe::JointSpring::new(
+                spring.stiffness,
+                spring.damping,
+                spring.rest_angle,
+            ));
+        }
         if let Some(m) = &joint.motor {
             if let Some(problem) = db::joint_motor_problems(m).into_iter().next() {
                 return Err(format!("{id}: motor: {problem}"));
             }
             let at_start = m.angular_at(0);
             def.motor = Some(JointMotor {
+                target_angle: m.target_angle,
                 enabled: at_start.is_some(),
                 ..JointMotor::new(
                     pe_joint_speed(at_start.unwrap_or(m.angular), self.dt),
@@ -362,7 +373,7 @@ impl Simulation {
 
     /// Takes up, without starting again, the changes of `model` that a running scene can
     /// follow (as Algodoo does): the scene's gravitation, friction and step, and its
-    /// robots' joint motors' speeds and torques. False, and nothing changed, if anything
+    /// robots' joint motors' speeds, torques and servo angles. False, and nothing changed, if anything
     /// else differs or a new number is one the scene may not have: then it is to be
     /// built again.
     pub fn follow_live_edit(&mut self, model: &Model) -> bool {
@@ -377,6 +388,7 @@ impl Simulation {
         for (handle, m) in motors {
             if let Some(motor) = self.world.joint_motor_mut(handle) {
                 motor.max_torque = m.max_torque;
+                motor.target_angle = m.target_angle;
             }
             if let Some(j) = self.joints.iter_mut().find(|j| j.handle == handle) {
                 j.motor = Some(m);
@@ -407,6 +419,7 @@ impl Simulation {
             for j in m.robots.iter_mut().flat_map(|r| &mut r.joints) {
                 if let Some(motor) = &mut j.motor {
                     (motor.angular, motor.max_torque) = (0.0, 0.0);
+                    motor.target_angle = None;
                 }
             }
             m

@@ -553,10 +553,18 @@ impl World {
     }
 
     /// Potential energy in the uniform gravity field, zero at the world origin.
+    /// Gravity's potential energy and the joint springs': ½·k·(θ − rest)² each.
     pub fn potential_energy(&self) -> f64 {
-        self.bodies()
+        let gravity: f64 = self
+            .bodies()
             .map(|(_, b)| -b.mass() * self.gravity.dot(&b.position))
-            .sum()
+            .sum();
+        let springs = (0..self.joints.len() as u32).filter_map(|k| {
+            let spring = self.joints[k as usize]?.spring?;
+            let stretch = self.joint_angle(JointHandle(k))? - spring.rest_angle;
+            Some(0.5 * spring.stiffness * stretch * stretch)
+        });
+        springs.fold(gravity, |sum, e| sum + e)
     }
 
     pub fn linear_momentum(&self) -> Vec2 {

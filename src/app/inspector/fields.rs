@@ -265,6 +265,7 @@ pub fn joint_fields(
                     .changed(),
             );
             ui.end_row();
+            spring_rows(ui, j, key, edit);
             ui.label("motor").on_hover_text("A joint motor: turns body B against body A");
             let mut has = j.motor.is_some();
             if ui
@@ -329,8 +330,81 @@ pub fn joint_fields(
                         .changed(),
                 );
                 ui.end_row();
+                servo_row(ui, m, key, edit);
             }
         });
+}
+
+/// A joint's spring rows in its grid: on or off, then stiffness, damping, rest angle.
+fn spring_rows(ui: &mut Ui, j: &mut JointDef, key: &str, edit: &mut Edit) {
+    ui.label("spring").on_hover_text(
+        "A rotational spring-damper: torque on body B −stiffness·(angle − rest) − damping·(spin of B against A)",
+    );
+    let mut has = j.spring.is_some();
+    if ui.checkbox(&mut has, "spring").changed() {
+        j.spring = has.then_some(crate::model::JointSpringDef {
+            stiffness: 1e6,
+            damping: 0.0,
+            rest_angle: 0.0,
+        });
+        edit.touched(format!("{key} spring"), true);
+    }
+    ui.end_row();
+    let Some(spring) = j.spring.as_mut() else {
+        return;
+    };
+    let rows = [
+        (
+            "stiffness",
+            &mut spring.stiffness,
+            "Torque per radian the joint turns from rest",
+            "",
+        ),
+        (
+            "damping",
+            &mut spring.damping,
+            "Torque per rad/s of body B's spin against body A",
+            "",
+        ),
+        (
+            "rest angle",
+            &mut spring.rest_angle,
+            "The joint's angle where the spring is slack; 0 is as placed",
+            " rad",
+        ),
+    ];
+    for (label, value, tip, suffix) in rows {
+        ui.label(label).on_hover_text(tip);
+        let speed = if suffix.is_empty() { 1e3 } else { 0.01 };
+        let mut drag = DragValue::new(value).speed(speed).suffix(suffix);
+        if suffix.is_empty() {
+            drag = drag.range(0.0..=f64::MAX);
+        }
+        edit.touched(format!("{key} spring {label}"), ui.add(drag).changed());
+        ui.end_row();
+    }
+}
+
+/// A joint motor's servo row: on, it drives the joint to an angle and holds it there.
+fn servo_row(ui: &mut Ui, m: &mut JointMotorDef, key: &str, edit: &mut Edit) {
+    ui.label("servo to").on_hover_text(
+        "A servo drives the joint's angle (0 as placed) to this, at no more than the speed, and holds it there",
+    );
+    ui.horizontal(|ui| {
+        let mut servo = m.target_angle.is_some();
+        if ui.checkbox(&mut servo, "").on_hover_text("servo").changed() {
+            m.target_angle = servo.then_some(0.0);
+            edit.touched(format!("{key} servo"), true);
+        }
+        if let Some(angle) = m.target_angle.as_mut() {
+            edit.touched(
+                format!("{key} servo angle"),
+                ui.add(DragValue::new(angle).speed(0.01).suffix(" rad"))
+                    .changed(),
+            );
+        }
+    });
+    ui.end_row();
 }
 
 /// An arrow for which way a motor of speed `angular` turns `body` (relative to `other`,
