@@ -145,7 +145,7 @@ impl World {
             .iter()
             .filter_map(|&k| self.joints[k as usize].and_then(|j| j.motor))
             .filter(|m| m.enabled)
-            .map(|m| m.target_speed.abs());
+            .map(|m| m.drive_speed().abs());
         let fastest = bodies.chain(motors).fold(0.0, f64::max);
         ((fastest * dt / MAX_TURN).ceil() as usize).clamp(1, MAX_SOFT_SUBSTEPS)
     }
