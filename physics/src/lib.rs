@@ -54,7 +54,7 @@ pub use crate::{
     solver::{
         ContactSolver,
         contact::Contact,
-        joint::{Joint, JointHandle, JointMotor, JointSpring},
+        joint::{Joint, JointHandle, JointLimits, JointMotor, JointSpring},
         motor::{BodyMotor, MotorError},
         report::{IslandMethod, IslandReport, StepStats},
         soft::lane_path_name,

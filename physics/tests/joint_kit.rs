@@ -1,9 +1,10 @@
 //! The robot builder's kit on a pin (issue 65), against known answers: a rotational
-//! spring's period, energy and damping; a servo's reach, overshoot and hold under load.
+//! spring's period, energy and damping; a servo's reach, overshoot and hold under load;
+//! a stop that holds a pendulum, a weld that holds a cantilever.
 
 use pe::{
-    BodyDef, ContactSolver, ConvexPolygon, JointDef, JointHandle, JointMotor, JointSpring, Vec2,
-    World,
+    BodyDef, ContactSolver, ConvexPolygon, JointDef, JointHandle, JointLimits, JointMotor,
+    JointSpring, Vec2, World,
 };
 
 const H: f64 = 1.0 / 60.0;
@@ -164,5 +165,54 @@ fn a_servo_reaches_its_angle_without_overshoot_and_holds_it_under_load() {
         assert!(highest < 1.02, "{solver:?}: overshot to {highest}");
         let held = w.joint_angle(joint).unwrap();
         assert!((held - 1.0).abs() < 0.01, "{solver:?}: held at {held}");
+    }
+}
+
+const SOLVERS: [ContactSolver; 3] = [
+    ContactSolver::Auto,
+    ContactSolver::Exact,
+    ContactSolver::Soft,
+];
+
+#[test]
+fn a_pendulum_released_level_stops_at_its_limit_and_rests_on_it() {
+    for solver in SOLVERS {
+        // Gravity swings the bar down: θ (= −its angle, pinned to the world) falls
+        // towards the lower stop at −0.5.
+        let (mut w, joint) = pinned_bar(solver, 9.8, |d| {
+            d.limits = Some(JointLimits::new(-0.5, 0.5));
+        });
+        let mut lowest = f64::INFINITY;
+        for _ in 0..600 {
+            w.try_step(H).unwrap();
+            lowest = lowest.min(w.joint_angle(joint).unwrap());
+        }
+        assert!(
+            lowest > -0.51,
+            "{solver:?}: beyond the stop by {}",
+            -0.5 - lowest
+        );
+        let theta = w.joint_angle(joint).unwrap();
+        let body = w.bodies().next().unwrap().1;
+        assert!(
+            (theta + 0.5).abs() < 0.01 && body.angular_velocity.abs() < 1e-3,
+            "{solver:?}: at rest on the stop: θ {theta}, spin {}",
+            body.angular_velocity
+        );
+    }
+}
+
+#[test]
+fn a_welded_beam_cantilevered_from_its_mount_does_not_sag() {
+    for solver in SOLVERS {
+        let (mut w, joint) = pinned_bar(solver, 9.8, |d| {
+            d.limits = Some(JointLimits::new(0.0, 0.0));
+        });
+        let mut worst: f64 = 0.0;
+        for _ in 0..600 {
+            w.try_step(H).unwrap();
+            worst = worst.max(w.joint_angle(joint).unwrap().abs());
+        }
+        assert!(worst < 1e-3, "{solver:?}: sagged {worst} rad");
     }
 }

@@ -34,6 +34,64 @@ pub struct Joint {
     /// made: the joint's angle θ counts from it, so that θ = 0 as placed.
     pub reference_angle: f64,
     pub spring: Option<JointSpring>,
+    pub limits: Option<JointLimits>,
+}
+
+/// Stops on a joint's angle θ: lower ≤ θ ≤ upper; equal, a weld. Solved as inequality
+/// rows on the relative spin (an equality row for a weld) in the exact solver's LCPs and
+/// its joint passes, and as Box2D v3 solves them in the soft step: a stop ahead lets the
+/// joint reach it exactly in the step (speculative); one passed is pushed back at a
+/// fifth of the way a step, so that it does not bounce off.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointLimits {
+    pub lower: f64,
+    pub upper: f64,
+}
+
+/// The share of a passed stop's overlap the exact solver takes back per step.
+const LIMIT_PUSH_BACK: f64 = 0.2;
+
+impl JointLimits {
+    pub fn new(lower: f64, upper: f64) -> Self {
+        Self { lower, upper }
+    }
+
+    pub fn is_weld(&self) -> bool {
+        self.lower == self.upper
+    }
+
+    /// Both finite, within `crate::limits::ANGLE`, lower ≤ upper.
+    pub(crate) fn validate(&self) -> Result<(), super::motor::MotorError> {
+        use super::motor::MotorError;
+        for (what, value) in [("lower angle", self.lower), ("upper angle", self.upper)] {
+            if !value.is_finite() {
+                return Err(MotorError::NonFinite(what, value));
+            }
+            if value.abs() > crate::limits::ANGLE {
+                return Err(MotorError::Beyond(what, value, crate::limits::ANGLE));
+            }
+        }
+        if self.lower > self.upper {
+            return Err(MotorError::Negative(
+                "upper − lower angle",
+                self.upper - self.lower,
+            ));
+        }
+        Ok(())
+    }
+
+    /// The bounds a step of `dt` puts on s = ω_A − ω_B (the motors' sign; θ grows with
+    /// −s) at angle θ: s ≤ the first (the lower stop), s ≥ the second (the upper).
+    pub(crate) fn spin_bounds(&self, theta: f64, dt: f64) -> (f64, f64) {
+        let room = |c: f64| {
+            if c >= 0.0 {
+                c / dt
+            } else {
+                LIMIT_PUSH_BACK * c / dt
+            }
+        };
+        (room(theta - self.lower), -room(self.upper - theta))
+    }
 }
 
 /// A rotational spring-damper across a joint: torque on body B
@@ -131,6 +189,11 @@ pub(crate) struct JointConstraint {
     pub local_anchor_a: Vec2,
     pub local_anchor_b: Vec2,
     pub motor: Option<JointMotor>,
+    /// The joint's stops, and θ's offset: θ = angle_B − angle_A − reference_angle.
+    pub limits: Option<JointLimits>,
+    pub reference_angle: f64,
+    /// The impulses the stops have put on s = ω_A − ω_B this step (lower, upper).
+    pub limit_impulse: (f64, f64),
     /// The predicted gap this step's position pass aims for: zero, unless the joint is
     /// broken wider than one step may close (see [`JointIterations::max_closing`]).
     pub gap_target: Vec2,

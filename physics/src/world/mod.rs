@@ -35,7 +35,9 @@ use crate::solver::contact::Contact;
 use crate::solver::exact::SimultaneousSolver;
 use crate::solver::exact::joint_block::JointBlockSolver;
 use crate::solver::impacts::ImpactPass;
-use crate::solver::joint::{Joint, JointConstraint, JointHandle, JointMotor, JointSpring};
+use crate::solver::joint::{
+    Joint, JointConstraint, JointHandle, JointLimits, JointMotor, JointSpring,
+};
 use crate::solver::motor::{BodyMotor, MotorError};
 use crate::solver::report::{IslandReport, StepStats};
 use crate::solver::soft::SoftStepSolver;
@@ -79,6 +81,7 @@ pub struct JointDef {
     pub collide_connected: bool,
     pub motor: Option<JointMotor>,
     pub spring: Option<JointSpring>,
+    pub limits: Option<JointLimits>,
 }
 
 impl JointDef {
@@ -92,6 +95,7 @@ impl JointDef {
             collide_connected: false,
             motor: None,
             spring: None,
+            limits: None,
         }
     }
 }
@@ -402,6 +406,9 @@ impl World {
         if let Some(s) = &def.spring {
             s.validate().map_err(JointError::BadMotor)?;
         }
+        if let Some(l) = &def.limits {
+            l.validate().map_err(JointError::BadMotor)?;
+        }
         let a = self.body(def.body_a).ok_or(JointError::MissingBody)?;
         let local_anchor_a = a.to_local(def.anchor);
         let angle_a = a.angle;
@@ -421,6 +428,7 @@ impl World {
             motor: def.motor,
             reference_angle: angle_b - angle_a,
             spring: def.spring,
+            limits: def.limits,
         }));
         self.collision_filter_stale = true;
         Ok(JointHandle((self.joints.len() - 1) as u32))

@@ -81,6 +81,9 @@ impl World {
                 local_anchor_a: j.local_anchor_a,
                 local_anchor_b: j.local_anchor_b,
                 motor: j.motor,
+                limits: j.limits,
+                reference_angle: j.reference_angle,
+                limit_impulse: (0.0, 0.0),
                 gap_target: Vec2::zeros(),
                 impulse: Vec2::zeros(),
             };

@@ -54,10 +54,10 @@ pub(crate) fn correct_positions(
     it.max_sweeps
 }
 
-/// Joint motors as bounded velocity constraints, solved by projected Gauss–Seidel on the
-/// accumulated impulse so the bound ±max_torque·h holds over the whole step; unless
-/// `fresh`, keeping the impulses already applied this step so the bound holds over several
-/// rounds.
+/// Joint motors as bounded velocity constraints, and joints' stops as one-sided ones,
+/// solved by projected Gauss–Seidel on the accumulated impulse so the bound ±max_torque·h
+/// holds over the whole step; unless `fresh`, keeping the impulses already applied this
+/// step so the bound holds over several rounds.
 fn drive_motors_continue(
     joints: &mut [JointConstraint],
     bodies: &mut [SolverBody],
@@ -70,29 +70,51 @@ fn drive_motors_continue(
             if let Some(m) = j.motor.as_mut() {
                 m.last_impulse = 0.0;
             }
+            j.limit_impulse = (0.0, 0.0);
         }
     }
     for _ in 0..sweeps {
         for j in joints.iter_mut() {
-            let Some(motor) = j.motor.as_mut().filter(|m| m.enabled) else {
-                continue;
-            };
             let (ia, ib) = (j.body_a as usize, j.body_b as usize);
             let k = bodies[ia].inv_inertia + bodies[ib].inv_inertia;
             if k == 0.0 {
                 continue;
             }
-            let relative = bodies[ia].angular_velocity - bodies[ib].angular_velocity;
-            let limit = motor.max_torque * dt;
-            let total = clamp(
-                motor.last_impulse - (relative - motor.drive_speed()) / k,
-                -limit,
-                limit,
-            );
-            let delta = total - motor.last_impulse;
-            motor.last_impulse = total;
-            bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;
-            bodies[ib].angular_velocity -= delta * bodies[ib].inv_inertia;
+            let push = |bodies: &mut [SolverBody], delta: f64| {
+                bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;
+                bodies[ib].angular_velocity -= delta * bodies[ib].inv_inertia;
+            };
+            let relative =
+                |bodies: &[SolverBody]| bodies[ia].angular_velocity - bodies[ib].angular_velocity;
+            if let Some(motor) = j.motor.as_mut().filter(|m| m.enabled) {
+                let limit = motor.max_torque * dt;
+                let total = clamp(
+                    motor.last_impulse - (relative(bodies) - motor.drive_speed()) / k,
+                    -limit,
+                    limit,
+                );
+                let delta = total - motor.last_impulse;
+                motor.last_impulse = total;
+                push(bodies, delta);
+            }
+            if let Some(limits) = j.limits {
+                let theta = bodies[ib].angle - bodies[ia].angle - j.reference_angle;
+                let (at_most, at_least) = limits.spin_bounds(theta, dt);
+                let (lower, upper) = j.limit_impulse;
+                let lower_total = lower - (relative(bodies) - at_most) / k;
+                let lower_total = if limits.is_weld() {
+                    lower_total
+                } else {
+                    lower_total.min(0.0)
+                };
+                push(bodies, lower_total - lower);
+                let mut upper_total = upper;
+                if !limits.is_weld() {
+                    upper_total = (upper - (relative(bodies) - at_least) / k).max(0.0);
+                    push(bodies, upper_total - upper);
+                }
+                j.limit_impulse = (lower_total, upper_total);
+            }
         }
     }
 }
@@ -277,7 +299,10 @@ impl JointBlockSolver {
     ) {
         let (pin_island, motor_speeds) = (&mut self.pin_island, &mut self.motor_speeds);
         self.islands.for_each(joints, bodies, |island, bodies| {
-            let has_motor = island.iter().any(|j| j.motor.is_some_and(|m| m.enabled));
+            // Motors and stops: the rows on the joints' relative spins.
+            let has_motor = island
+                .iter()
+                .any(|j| j.motor.is_some_and(|m| m.enabled) || j.limits.is_some());
             let direct = island.len() <= DIRECT_JOINT_LIMIT;
             if !direct {
                 if has_motor {

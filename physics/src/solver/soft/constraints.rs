@@ -7,6 +7,7 @@ use super::bodies::SoftBody;
 use crate::math::Vec2;
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
+use crate::solver::joint::JointLimits;
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(super) struct PointConstraint {
@@ -154,6 +155,10 @@ pub(super) struct SoftJoint {
     /// The motor's angular impulse summed over this step's substeps.
     pub(super) motor_step_total: f64,
     pub(super) motor: Option<(f64, f64)>,
+    /// The joint's stops and its angle θ at the step's start (θ now: that plus body B's
+    /// turn since less body A's), with the stops' accumulated impulses on ω_A − ω_B.
+    pub(super) limits: Option<(JointLimits, f64)>,
+    pub(super) limit_impulse: (f64, f64),
     pub(super) slot: u32,
     /// Its index in the step's input joints (the solver reorders them by island).
     pub(super) input: u32,

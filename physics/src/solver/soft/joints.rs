@@ -91,6 +91,8 @@ impl SoftPins {
                 motor_impulse: if motor.is_some() { motor_impulse } else { 0.0 },
                 motor_step_total: 0.0,
                 motor,
+                limits: j.limits.map(|l| (l, b.angle - a.angle - j.reference_angle)),
+                limit_impulse: (0.0, 0.0),
                 slot: j.joint,
                 input: input as u32,
             });
@@ -102,7 +104,7 @@ impl SoftPins {
             .joints
             .iter()
             .enumerate()
-            .filter(|(_, j)| j.motor.is_some());
+            .filter(|(_, j)| j.motor.is_some() || j.limits.is_some());
         self.motor_joints.extend(motors.map(|(k, _)| k as u32));
         let unchanged = self.joint_grouping.kept();
         self.pin_plan
@@ -231,13 +233,14 @@ impl SoftStepSolver {
     }
 }
 
-/// Re-applies a pin's motor's accumulated angular impulse (zero without one).
+/// Re-applies a pin's motor's and stops' accumulated angular impulse (zero without).
 pub(super) fn warm_start_motor(bodies: &mut [SoftBody], j: &SoftJoint) {
     let (a, b) = (j.a as usize, j.b as usize);
+    let impulse = j.motor_impulse + j.limit_impulse.0 + j.limit_impulse.1;
     let ia = bodies[a].inv_inertia;
-    bodies[a].w += ia * j.motor_impulse;
+    bodies[a].w += ia * impulse;
     let ib = bodies[b].inv_inertia;
-    bodies[b].w -= ib * j.motor_impulse;
+    bodies[b].w -= ib * impulse;
 }
 
 /// Re-applies a pin's accumulated impulse (not its motor's) at the start of a substep,
@@ -249,8 +252,15 @@ pub(super) fn warm_start_pin(bodies: &mut [SoftBody], j: &SoftJoint) {
     SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, j.impulse);
 }
 
-/// A joint motor: the relative spin driven towards its target, within ±max torque·h.
-pub(super) fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
+/// A joint motor: the relative spin driven towards its target, within ±max torque·h;
+/// then the joint's stops (`solve_limits`).
+pub(super) fn solve_motor(
+    bodies: &mut [SoftBody],
+    j: &mut SoftJoint,
+    h: f64,
+    soft: &Softness,
+    use_bias: bool,
+) {
     if let Some((target, max_torque)) = j.motor {
         let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
         let k = a.inv_inertia + b.inv_inertia;
@@ -262,6 +272,70 @@ pub(super) fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
             bodies[j.a as usize].w += a.inv_inertia * delta;
             bodies[j.b as usize].w -= b.inv_inertia * delta;
         }
+    }
+    if j.limits.is_some() {
+        solve_limits(bodies, j, h, soft, use_bias);
+    }
+}
+
+/// A joint's stops, as Box2D v3 solves a revolute joint's limits: a stop ahead lets the
+/// joint reach it in the substep (speculative, rigid); one passed is pushed back softly
+/// (the pins' softness) in the biased pass and only held in the relaxing one. Each
+/// stop's accumulated impulse stays one-signed; a weld's is free.
+fn solve_limits(
+    bodies: &mut [SoftBody],
+    j: &mut SoftJoint,
+    h: f64,
+    soft: &Softness,
+    use_bias: bool,
+) {
+    let Some((limits, theta_start)) = j.limits else {
+        return;
+    };
+    let (ia, ib) = (j.a as usize, j.b as usize);
+    let k = bodies[ia].inv_inertia + bodies[ib].inv_inertia;
+    if k <= 0.0 {
+        return;
+    }
+    let theta = theta_start + bodies[ib].dangle - bodies[ia].dangle;
+    // Each stop as a gap C ≥ 0 closing at the speed `closing` (along s = ω_A − ω_B for
+    // the lower stop, −s for the upper), its impulse along that sign.
+    let stops = [(theta - limits.lower, 1.0), (limits.upper - theta, -1.0)];
+    let weld = limits.is_weld();
+    for (index, (gap, sign)) in stops.into_iter().enumerate() {
+        if weld && index == 1 {
+            break;
+        }
+        let (bias, mass_scale, impulse_scale) = if gap > 0.0 {
+            (gap / h, 1.0, 0.0)
+        } else if use_bias {
+            (soft.bias_rate * gap, soft.mass_scale, soft.impulse_scale)
+        } else {
+            (0.0, 1.0, 0.0)
+        };
+        let accumulated = if index == 0 {
+            j.limit_impulse.0
+        } else {
+            j.limit_impulse.1
+        };
+        // The gap's rate: for the lower stop −s, for the upper s.
+        let s = bodies[ia].w - bodies[ib].w;
+        let rate = -sign * s;
+        let along = -mass_scale * (rate + bias) / k - impulse_scale * (-sign * accumulated);
+        // `along` is the impulse on the gap's rate; on s it is −sign times that.
+        let mut total_along = -sign * accumulated + along;
+        if !weld {
+            total_along = total_along.max(0.0);
+        }
+        let total = -sign * total_along;
+        let delta = total - accumulated;
+        if index == 0 {
+            j.limit_impulse.0 = total;
+        } else {
+            j.limit_impulse.1 = total;
+        }
+        bodies[ia].w += bodies[ia].inv_inertia * delta;
+        bodies[ib].w -= bodies[ib].inv_inertia * delta;
     }
 }
 
@@ -487,6 +561,9 @@ mod tests {
                     Vec2::new(0.5, 0.0)
                 },
                 motor: None,
+                limits: None,
+                reference_angle: 0.0,
+                limit_impulse: (0.0, 0.0),
                 gap_target: Vec2::zeros(),
                 impulse: Vec2::zeros(),
             })

@@ -500,6 +500,9 @@ mod tests {
             local_anchor_a: Vec2::new(0.5, -0.5),
             local_anchor_b: Vec2::new(0.5, 0.5),
             motor: None,
+            limits: None,
+            reference_angle: 0.0,
+            limit_impulse: (0.0, 0.0),
             gap_target: Vec2::zeros(),
             impulse: Vec2::zeros(),
         }];

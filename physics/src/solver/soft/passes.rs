@@ -203,6 +203,8 @@ impl SoftStepSolver {
                 &mut self.loaded.bodies,
                 &mut self.pins.joints[k as usize],
                 h,
+                joint_soft,
+                use_bias,
             );
         }
         for (index, &(start, end)) in self.pins.joint_islands.iter().enumerate() {

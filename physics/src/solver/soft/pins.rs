@@ -465,6 +465,8 @@ mod tests {
             motor_impulse: 0.0,
             motor_step_total: 0.0,
             motor: None,
+            limits: None,
+            limit_impulse: (0.0, 0.0),
             slot: k as u32,
             input: k as u32,
         }
