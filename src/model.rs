@@ -153,6 +153,10 @@ pub struct JointDef {
     /// spring-damper across the joint, torque on B −stiffness·(θ − restAngle) −
     /// damping·(ω_B − ω_A), θ = 0 as placed. None without stiffness or damping.
     pub spring: Option<JointSpringDef>,
+    /// Extension (attributes `lowerAngle`, `upperAngle`, radians): stops on the joint's
+    /// angle θ (θ = 0 as placed); equal, a weld. Either may be left out (no stop there).
+    pub lower_angle: Option<f64>,
+    pub upper_angle: Option<f64>,
     pub motor: Option<JointMotorDef>,
     pub extra: ExtraAttributes,
     pub location: Location,

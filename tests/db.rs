@@ -190,23 +190,28 @@ fn model() -> impl Strategy<Value = Model> {
         any::<bool>(),
         prop::option::of(joint_motor),
         prop::option::of((number(), number(), number())),
+        (prop::option::of(number()), prop::option::of(number())),
     )
-        .prop_map(|(a, b, ax, ay, collide, motor, spring)| JointDef {
-            body_a: a,
-            body_b: b,
-            anchor_ax: ax,
-            anchor_ay: ay,
-            collide,
-            motor,
-            spring: spring.map(
-                |(stiffness, damping, rest_angle)| robosim::model::JointSpringDef {
-                    stiffness,
-                    damping,
-                    rest_angle,
-                },
-            ),
-            ..JointDef::default()
-        });
+        .prop_map(
+            |(a, b, ax, ay, collide, motor, spring, (lower_angle, upper_angle))| JointDef {
+                body_a: a,
+                body_b: b,
+                anchor_ax: ax,
+                anchor_ay: ay,
+                collide,
+                motor,
+                lower_angle,
+                upper_angle,
+                spring: spring.map(|(stiffness, damping, rest_angle)| {
+                    robosim::model::JointSpringDef {
+                        stiffness,
+                        damping,
+                        rest_angle,
+                    }
+                }),
+                ..JointDef::default()
+            },
+        );
     let robot = (
         name(),
         prop::collection::vec((placement(), prop::collection::vec(motor, 0..2)), 0..4),

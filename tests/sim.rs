@@ -696,3 +696,48 @@ fn joint_springs_and_servos_from_the_files_move_the_joint() {
     let refused = Simulation::new(&model, "servo", None, None).err().unwrap();
     assert!(refused.to_string().contains("stiffness"), "{refused}");
 }
+
+/// Stops from the files (issue 65): a double pendulum whose joints stop at ±0.4 rad
+/// swings within them; `check` and the build refuse a lower stop above the upper.
+#[test]
+fn joint_stops_from_the_files_hold_the_pendulum_within_them() {
+    let mut model = model();
+    for j in &mut model
+        .robots
+        .iter_mut()
+        .find(|r| r.name == "double pendulum")
+        .unwrap()
+        .joints
+    {
+        (j.lower_angle, j.upper_angle) = (Some(-0.4), Some(0.4));
+    }
+    let mut sim = Simulation::new(&model, "double pendulum", None, None).unwrap();
+    let handles: Vec<_> = sim.joints.iter().map(|j| j.handle).collect();
+    let mut widest: f64 = 0.0;
+    for _ in 0..600 {
+        sim.try_step().unwrap();
+        for &h in &handles {
+            widest = widest.max(sim.world.joint_angle(h).unwrap().abs());
+        }
+    }
+    // Measured 0.4 to the last digit under the default solver (auto: exact for a robot).
+    assert!(widest <= 0.4 + 1e-6, "a joint reached {widest} rad");
+    assert!(widest > 0.39, "the pendulum swings to its stops: {widest}");
+
+    let robot = model
+        .robots
+        .iter_mut()
+        .find(|r| r.name == "double pendulum");
+    robot.unwrap().joints[0].lower_angle = Some(0.5);
+    let problems = robosim::db::check(&model, |k| format!("{k:?}.xml"));
+    assert!(
+        problems.iter().any(|p| p
+            .to_string()
+            .contains("lowerAngle 0.5 is above upperAngle 0.4")),
+        "{problems:#?}"
+    );
+    let refused = Simulation::new(&model, "double pendulum", None, None)
+        .err()
+        .unwrap();
+    assert!(refused.to_string().contains("lowerAngle"), "{refused}");
+}

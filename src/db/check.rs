@@ -4,7 +4,7 @@
 use super::problem::Problem;
 use super::{FileKind, clip};
 use crate::model::{
-    BodyDef, BodyMotorDef, JointMotorDef, JointSpringDef, Model, Placement, Robot, Scene,
+    BodyDef, BodyMotorDef, JointDef, JointMotorDef, JointSpringDef, Model, Placement, Robot, Scene,
     SceneRobot, StartVelocity, compose,
 };
 use pe::{ContactSolver, ConvexPolygon, Vec2};
@@ -95,6 +95,20 @@ fn velocity_beyond(v: &StartVelocity) -> Vec<String> {
         ("vy", v.vy, limits::SPEED),
         ("omega", v.omega, limits::SPIN),
     ])
+}
+
+/// A joint's stops: within `pe::limits`, the lower not above the upper.
+pub fn joint_limit_problems(j: &JointDef) -> Vec<String> {
+    let mut out = beyond_all(&[
+        ("lowerAngle", j.lower_angle.unwrap_or(0.0), limits::ANGLE),
+        ("upperAngle", j.upper_angle.unwrap_or(0.0), limits::ANGLE),
+    ]);
+    if let (Some(lower), Some(upper)) = (j.lower_angle, j.upper_angle)
+        && lower > upper
+    {
+        out.push(format!("lowerAngle {lower} is above upperAngle {upper}"));
+    }
+    out
 }
 
 /// A joint spring's numbers: stiffness and damping ≥ 0, all within `pe::limits`.
@@ -330,6 +344,9 @@ fn check_robot(model: &Model, robot: &Robot, file: &str, out: &mut Vec<Problem>)
                     .at(j.location),
                 );
             }
+        }
+        for message in joint_limit_problems(j) {
+            out.push(Problem::error(file, &what, message).at(j.location));
         }
         if let Some(spring) = &j.spring {
             for message in joint_spring_problems(spring) {

@@ -9,9 +9,9 @@ pub mod write;
 mod xml;
 
 pub use check::{
-    TIMESTEP_RANGE, beyond_all, body_motor_problems, check, joint_motor_problems,
-    joint_spring_problems, limits, outline_polygon, polygon, scene_number_problems,
-    timestep_problem,
+    TIMESTEP_RANGE, beyond_all, body_motor_problems, check, joint_limit_problems,
+    joint_motor_problems, joint_spring_problems, limits, outline_polygon, polygon,
+    scene_number_problems, timestep_problem,
 };
 pub use problem::{Problem, Severity, one_line};
 pub use xml::{MAX_DEPTH, clip};

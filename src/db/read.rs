@@ -325,10 +325,14 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
                         anchor_ay: f.number("anchorAy"),
                         collide: f.flag("collide"),
                         spring: None,
+                        lower_angle: None,
+                        upper_angle: None,
                         motor: None,
                         extra: Vec::new(),
                         location: child.location,
                     };
+                    joint.lower_angle = f.optional_number("lowerAngle");
+                    joint.upper_angle = f.optional_number("upperAngle");
                     let (stiffness, damping) =
                         (f.optional_number("stiffness"), f.optional_number("damping"));
                     let rest_angle = f.optional_number("restAngle");

@@ -176,6 +176,12 @@ pub fn robot(r: &Robot, out: &mut String) {
         if j.collide {
             tag = tag.text("collide", "true");
         }
+        if let Some(lower) = j.lower_angle {
+            tag = tag.num("lowerAngle", lower);
+        }
+        if let Some(upper) = j.upper_angle {
+            tag = tag.num("upperAngle", upper);
+        }
         if let Some(spring) = &j.spring {
             tag = tag
                 .num("stiffness", spring.stiffness)

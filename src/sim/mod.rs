@@ -334,6 +334,16 @@ impl Simulation {
     ) -> Result<(), String> {
         let mut def = pe::JointDef::new(a, Some(b), anchor);
         def.collide_connected = joint.collide;
+        if let Some(problem) = db::joint_limit_problems(joint).into_iter().next() {
+            return Err(format!("{id}: {problem}"));
+        }
+        if joint.lower_angle.is_some() || joint.upper_angle.is_some() {
+            let far = pe::limits::ANGLE;
+            def.limits = Some(pe::JointLimits::new(
+                joint.lower_angle.unwrap_or(-far),
+                joint.upper_angle.unwrap_or(far),
+            ));
+        }
         if let Some(spring) = &joint.spring {
             if let Some(problem) = db::joint_spring_problems(spring).into_iter().next() {
                 return Err(format!("{id}: spring: {problem}"));

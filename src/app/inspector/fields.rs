@@ -265,6 +265,7 @@ pub fn joint_fields(
                     .changed(),
             );
             ui.end_row();
+            limit_rows(ui, j, key, edit);
             spring_rows(ui, j, key, edit);
             ui.label("motor").on_hover_text("A joint motor: turns body B against body A");
             let mut has = j.motor.is_some();
@@ -333,6 +334,36 @@ pub fn joint_fields(
                 servo_row(ui, m, key, edit);
             }
         });
+}
+
+/// A joint's stops in its grid: each on or off, and its angle.
+fn limit_rows(ui: &mut Ui, j: &mut JointDef, key: &str, edit: &mut Edit) {
+    let tips = [
+        "The least angle the joint may reach (0 is as placed; equal stops weld it)",
+        "The greatest angle the joint may reach (0 is as placed; equal stops weld it)",
+    ];
+    let stops = [
+        ("lower stop", &mut j.lower_angle),
+        ("upper stop", &mut j.upper_angle),
+    ];
+    for ((label, stop), tip) in stops.into_iter().zip(tips) {
+        ui.label(label).on_hover_text(tip);
+        ui.horizontal(|ui| {
+            let mut on = stop.is_some();
+            if ui.checkbox(&mut on, "").on_hover_text(label).changed() {
+                *stop = on.then_some(0.0);
+                edit.touched(format!("{key} {label}"), true);
+            }
+            if let Some(angle) = stop.as_mut() {
+                edit.touched(
+                    format!("{key} {label} angle"),
+                    ui.add(DragValue::new(angle).speed(0.01).suffix(" rad"))
+                        .changed(),
+                );
+            }
+        });
+        ui.end_row();
+    }
 }
 
 /// A joint's spring rows in its grid: on or off, then stiffness, damping, rest angle.
