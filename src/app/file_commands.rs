@@ -209,8 +209,9 @@ impl RoboSimApp {
         format!("{shown} {}.{}", export.what(), export.extension())
     }
 
-    /// Asks where to write an export, starting in the database's folder; None when the
-    /// user cancelled, or when the app's own chooser asks (it carries on once answered).
+    /// Asks where to write an export, starting where the last one went (else in the
+    /// database's folder); None when the user cancelled, or when the app's own chooser
+    /// asks (it carries on once answered).
     fn export_path(&mut self, export: Export) -> Option<PathBuf> {
         if export != Export::Plots && self.runner.sim().is_none() {
             self.complain(format!(
@@ -219,7 +220,8 @@ impl RoboSimApp {
             ));
             return None;
         }
-        let folder = self.doc.folder().map(Path::to_path_buf);
+        let folder =
+            (self.export_folder.clone()).or_else(|| self.doc.folder().map(Path::to_path_buf));
         let (title, name, extension) =
             (export.title(), self.export_name(export), export.extension());
         if !self.no_system_dialog {
@@ -242,6 +244,7 @@ impl RoboSimApp {
     }
 
     fn export_to(&mut self, export: Export, path: PathBuf, ctx: &egui::Context) {
+        self.export_folder = path.parent().map(Path::to_path_buf);
         match export {
             Export::Plots => {
                 let csv = plots::to_csv(&self.runner.plot_data);

@@ -113,6 +113,8 @@ pub struct RoboSimApp {
     no_system_dialog: bool,
     /// The app's own file chooser, while it asks.
     in_app_chooser: Option<files::InAppChooser>,
+    /// Where the last export went: the next one is offered there.
+    export_folder: Option<PathBuf>,
     copied: Option<placements::Clipboard>,
     /// Text for the system clipboard, put there at the end of the frame (Ctrl+C, X).
     clipboard_out: Option<String>,
@@ -149,6 +151,7 @@ impl RoboSimApp {
             files: Box::new(files::SystemDialogs),
             no_system_dialog: false,
             in_app_chooser: None,
+            export_folder: None,
             copied: None,
             clipboard_out: None,
             pasted: None,
@@ -503,7 +506,7 @@ impl RoboSimApp {
                 self.runner
                     .change_throttle(if action == A::Up { 1 } else { -1 });
                 Command::Inform(format!(
-                    "joint motors at {}× their speed (↑ / ↓ change it, R resets)",
+                    "joint motors at {}× their speed (Up / Down change it, R resets)",
                     self.runner.throttle()
                 ))
             }

@@ -165,12 +165,14 @@ impl Runner {
                     Selection::Scene(_) => String::new(),
                 };
                 let internal = format!("scene \"{}\"", crate::db::clip(PREVIEW));
-                let e = if shown.is_empty() {
-                    e.to_string()
-                } else {
-                    e.to_string().replace(&internal, &shown)
+                let e = e.to_string();
+                let e = match selection {
+                    Selection::Scene(_) => e,
+                    // `body "b": b: body "b": why`, said once.
+                    Selection::Body(_) => e.rfind(&shown).map_or(e.clone(), |i| e[i..].to_string()),
+                    Selection::Robot(_) => e.replace(&internal, &shown),
                 };
-                Err(e.to_string())
+                Err(e)
             }
         };
         self.restarted(followed);

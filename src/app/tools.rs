@@ -102,11 +102,11 @@ pub fn drawn_shape(
 
 /// A regular `n`-gon of circumradius `r` about the origin, with a flat edge at the bottom
 /// (+y, down on screen) so that it rests on the ground as drawn; vertices in the order of
-/// the app's other outlines, to a thousandth.
+/// the app's other outlines, to a thousandth (no `-0`: a file would keep it).
 pub fn regular_polygon(n: u32, r: f64) -> Vec<[f64; 2]> {
     use std::f64::consts::{FRAC_PI_2, PI, TAU};
     let start = FRAC_PI_2 + PI / n as f64;
-    let round = |v: f64| (v * 1000.0).round() / 1000.0;
+    let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
     (0..n)
         .map(|k| {
             let a = start + TAU * k as f64 / n as f64;

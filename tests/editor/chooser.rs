@@ -96,3 +96,30 @@ fn an_export_without_a_file_dialog_is_written_where_the_apps_chooser_says() {
         "{svg:.200}"
     );
 }
+
+/// The next export is offered where the last one went, not back in the database's folder
+/// (a second person's hour: every export landed beside the XML files by default).
+#[test]
+fn the_next_export_is_offered_where_the_last_one_went() {
+    let dir = scratch_db();
+    let exports = dir.path().join("exports");
+    std::fs::create_dir(&exports).unwrap();
+    let first = exports.join("first.svg");
+    let mut h = harness_with_files(
+        dir.path(),
+        Scripted::new([Answer::Chosen(first.clone()), Answer::Unavailable]),
+    );
+    for _ in 0..2 {
+        click(&mut h, "File");
+        click(&mut h, "Export view as SVG…");
+        h.run_steps(2);
+    }
+    assert!(first.exists(), "the first export was written");
+    let shown = exports.display().to_string();
+    let field = |n: &AccessKitNode<'_>| {
+        n.role() == Role::TextInput
+            && n.value().as_deref() == Some(shown.as_str())
+            && n.labelled_by().next().is_none()
+    };
+    assert!(h.query_by(field).is_some(), "the chooser opened in {shown}");
+}

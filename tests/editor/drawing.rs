@@ -141,3 +141,29 @@ fn the_body_editor_keeps_its_view_while_an_outline_is_drawn() {
     assert_eq!(h.state().model().body(&name).unwrap().vertices.len(), 4);
     assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
 }
+
+/// The body editor's shapes (issue 64's second hour): Regular polygon writes whole
+/// thousandths with no `-0` (it wrote 7.3e-16 and showed -0.0), and a body cleared to
+/// redraw is named once in the status bar (it read `body "b": b: body "b": …`).
+#[test]
+fn a_regular_polygon_is_written_clean_and_a_cleared_body_is_named_once() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    new_item(&mut h, "body");
+    let name = match h.state().selection() {
+        Some(Selection::Body(name)) => name.clone(),
+        other => panic!("a new body is selected, not {other:?}"),
+    };
+    click(&mut h, "Regular polygon");
+    let vertices = h.state().model().body(&name).unwrap().vertices.clone();
+    assert!(vertices.len() >= 3);
+    for v in vertices.iter().flatten() {
+        assert!(
+            (v * 1000.0).fract() == 0.0 && !(*v == 0.0 && v.is_sign_negative()),
+            "{vertices:?}"
+        );
+    }
+    click(&mut h, "Clear and draw");
+    let status = h.state().status().to_string();
+    assert_eq!(status.matches(name.as_str()).count(), 1, "{status}");
+}

@@ -159,12 +159,7 @@ fn shape_tools(ui: &mut Ui, body: &mut BodyDef, edit: &mut Edit) {
             .on_hover_text("Replace the shape by a regular polygon of n sides and circumradius r")
             .clicked()
         {
-            body.vertices = (0..sides)
-                .map(|k| {
-                    let a = std::f64::consts::TAU * k as f64 / sides as f64;
-                    [radius * a.cos(), radius * a.sin()]
-                })
-                .collect();
+            body.vertices = crate::app::tools::regular_polygon(sides, radius);
             edit.touched("shape".into(), true);
         }
         let label = ui.label("n");
