@@ -302,7 +302,11 @@ pub fn joint_snap_point(model: &Model, robot: &Robot, p: Vec2, radius: f64) -> O
         let pl = &b.placement;
         let (s, c) = pl.orientation.sin_cos();
         let place = |v: Vec2| Vec2::new(pl.x + c * v.x - s * v.y, pl.y + s * v.x + c * v.y);
-        centres.push(place(polygon.mass_properties().centroid));
+        // To a thousandth, as the editor's other numbers: a centroid found by summing
+        // (5.000000000000002 for a hexagon's) would be written as it is.
+        let centre = place(polygon.mass_properties().centroid);
+        let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+        centres.push(Vec2::new(round(centre.x), round(centre.y)));
         vertices.extend(polygon.vertices().iter().map(|&v| place(v)));
     }
     let nearest = |points: &[Vec2]| {
