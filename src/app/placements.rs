@@ -377,7 +377,7 @@ impl RoboSimApp {
             }
             Some(Selection::Robot(robot)) if robot_bodies == clip.items.len() => draft
                 .robot_mut(&robot)
-                .map(|r| paste_into_robot(r, clip.items, clip.joints)),
+                .map(|r| paste_into_robot(r, clip.items, clip.joints, clip.bounds)),
             _ => {
                 return self.complain(
                     "paste a scene's robots and bodies into a scene, a robot's bodies into a robot"
@@ -393,10 +393,20 @@ impl RoboSimApp {
     }
 }
 
-/// Adds `items` (robot bodies) to `robot` beside where they were copied from, each under
-/// an alias not yet taken, with `joints` between them renamed to match; returns where
-/// they went. A joint's anchor is relative to its bodyA, which moves with it.
-fn paste_into_robot(robot: &mut Robot, items: Vec<Copied>, joints: Vec<JointDef>) -> Vec<Owner> {
+/// Adds `items` (robot bodies, copied from within `bounds`) to `robot` beside where they
+/// were copied from, clear of them to the right, each under an alias not yet taken, with
+/// `joints` between them renamed to match; returns where they went. A joint's anchor is
+/// relative to its bodyA, which moves with it.
+fn paste_into_robot(
+    robot: &mut Robot,
+    items: Vec<Copied>,
+    joints: Vec<JointDef>,
+    bounds: pe::Aabb,
+) -> Vec<Owner> {
+    // The copy's width and a tenth more: beside, not on top (a pasted copy overlapping
+    // its original is thrown apart once run).
+    let width = bounds.max.x - bounds.min.x;
+    let shift = (1.1 * width).max(20.0).ceil();
     let first = robot.bodies.len();
     let mut renamed: Vec<(String, String)> = Vec::new();
     for item in items {
@@ -411,8 +421,7 @@ fn paste_into_robot(robot: &mut Robot, items: Vec<Copied>, joints: Vec<JointDef>
         let alias = next_in_count(&aliases, &body.placement.alias);
         renamed.push((body.placement.alias.clone(), alias.clone()));
         body.placement.alias = alias;
-        body.placement.x += 20.0;
-        body.placement.y += 20.0;
+        body.placement.x += shift;
         robot.bodies.push(body);
     }
     let new_alias = |old: &str| {

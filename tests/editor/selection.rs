@@ -231,6 +231,12 @@ fn robot_bodies_duplicated_together_bring_the_joints_between_them() {
         ]
     );
     assert_eq!(robot.joints[2].anchor_ax, robot.joints[0].anchor_ax);
+    // Beside the original, clear of it (the three span x = −53..53: 106 wide), not 20 off
+    // and on top of it.
+    for k in 0..3 {
+        let (original, copy) = (&robot.bodies[k].placement, &robot.bodies[k + 3].placement);
+        assert_eq!((copy.x - original.x, copy.y), (117.0, original.y));
+    }
     undo(&mut h);
     assert_eq!(*h.state().model(), before);
 }
