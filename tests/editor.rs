@@ -939,6 +939,12 @@ fn f1_and_esc_close_the_shortcut_sheet_and_help_opens_the_guide() {
         h.query_by_label_contains("RoboSim edits and simulates")
             .is_some()
     );
+    // Its Markdown drawn, not shown as typed (`**Menu bar and toolbar**`).
+    assert!(h.query_by_label_contains("Menu bar and toolbar").is_some());
+    assert!(
+        h.query_by_label_contains("**").is_none(),
+        "raw Markdown shown"
+    );
 }
 
 /// The inspector keeps its width when a joint with a motor is opened (issue 64: the

@@ -180,34 +180,38 @@ pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
 
 /// The user guide (docs/user-guide.md, compiled in), as its text: always at hand, with
 /// no browser and no network.
-pub fn user_guide(ctx: &egui::Context, open: &mut bool) {
+/// docs/user-guide.md in a window, its Markdown drawn (headings, lists, tables, links);
+/// its screenshots left out (the window shows the app itself).
+pub fn user_guide(
+    ctx: &egui::Context,
+    open: &mut bool,
+    cache: &mut egui_commonmark::CommonMarkCache,
+) {
     if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
         *open = false;
         return;
     }
-    const GUIDE: &str = include_str!("../../docs/user-guide.md");
+    static GUIDE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    let guide = GUIDE.get_or_init(|| {
+        // Arrows as the default fonts can draw them.
+        let arrows = [("←", "<-"), ("→", "->"), ("↑", "up"), ("↓", "down")];
+        include_str!("../../docs/user-guide.md")
+            .lines()
+            .filter(|l| !l.starts_with("!["))
+            .map(|l| {
+                arrows
+                    .iter()
+                    .fold(l.to_string(), |l, (from, to)| l.replace(from, to))
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    });
     egui::Window::new("User guide")
         .open(open)
         .default_size([640.0, 520.0])
         .show(ctx, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                // Arrows as the default fonts can draw them.
-                let arrows = [("←", "<-"), ("→", "->"), ("↑", "up"), ("↓", "down")];
-                for line in GUIDE.lines().filter(|l| !l.starts_with("![")) {
-                    let line = arrows
-                        .iter()
-                        .fold(line.to_string(), |l, (from, to)| l.replace(from, to));
-                    let line = line.as_str();
-                    match line.strip_prefix("## ").or_else(|| line.strip_prefix("# ")) {
-                        Some(heading) => {
-                            ui.add_space(6.0);
-                            ui.heading(heading);
-                        }
-                        None => {
-                            ui.label(line);
-                        }
-                    }
-                }
+                egui_commonmark::CommonMarkViewer::new().show(ui, cache, guide);
             });
         });
 }

@@ -115,6 +115,8 @@ pub struct RoboSimApp {
     in_app_chooser: Option<files::InAppChooser>,
     /// Where the last export went: the next one is offered there.
     export_folder: Option<PathBuf>,
+    /// The user guide's Markdown, laid out once.
+    guide_markdown: egui_commonmark::CommonMarkCache,
     copied: Option<placements::Clipboard>,
     /// Text for the system clipboard, put there at the end of the frame (Ctrl+C, X).
     clipboard_out: Option<String>,
@@ -152,6 +154,7 @@ impl RoboSimApp {
             no_system_dialog: false,
             in_app_chooser: None,
             export_folder: None,
+            guide_markdown: Default::default(),
             copied: None,
             clipboard_out: None,
             pasted: None,
@@ -650,7 +653,7 @@ impl RoboSimApp {
             dialogs::shortcut_sheet(ctx, &mut self.show_shortcuts);
         }
         if self.show_guide {
-            dialogs::user_guide(ctx, &mut self.show_guide);
+            dialogs::user_guide(ctx, &mut self.show_guide, &mut self.guide_markdown);
         }
         if self.show_about {
             dialogs::about(ctx, &mut self.show_about);
