@@ -777,6 +777,8 @@ fn a_db_folder_that_does_not_exist_is_asked_about_not_opened_silently() {
     let missing = parent.path().join("no such folder");
     let mut h = harness(&missing);
     h.get_by_label_contains("does not exist");
+    // Nothing shown, nothing running: the toolbar offers Play, not Pause.
+    assert!(!h.state().is_running() && h.query_by_label("Pause").is_none());
     click(&mut h, "Open the examples instead");
     assert!(h.state().db().dir.is_none());
     assert!(!h.state().model().scenes.is_empty(), "the examples");

@@ -74,7 +74,7 @@ impl Default for Runner {
     fn default() -> Self {
         Self {
             sim: None,
-            running: true,
+            running: false,
             speed: 1.0,
             accumulator: 0.0,
             solver: ContactSolver::default(),
