@@ -97,24 +97,58 @@ fn drive_motors_continue(
                 motor.last_impulse = total;
                 push(bodies, delta);
             }
-            if let Some(limits) = j.limits {
-                let theta = bodies[ib].angle - bodies[ia].angle - j.reference_angle;
-                let (at_most, at_least) = limits.spin_bounds(theta, dt);
-                let (lower, upper) = j.limit_impulse;
-                let lower_total = lower - (relative(bodies) - at_most) / k;
-                let lower_total = if limits.is_weld() {
-                    lower_total
-                } else {
-                    lower_total.min(0.0)
-                };
-                push(bodies, lower_total - lower);
-                let mut upper_total = upper;
-                if !limits.is_weld() {
-                    upper_total = (upper - (relative(bodies) - at_least) / k).max(0.0);
-                    push(bodies, upper_total - upper);
-                }
-                j.limit_impulse = (lower_total, upper_total);
+            if j.limits.is_some() {
+                hold_stops(j, bodies, dt);
             }
+        }
+    }
+}
+
+/// A joint's stops (`JointLimits`) as one-sided constraints on s = ω_A − ω_B (a weld's
+/// two-sided), on the impulses they have already applied this step: s ≤ the lower stop's
+/// bound with an impulse ≤ 0, s ≥ the upper's with one ≥ 0. Gauss–Seidel, not rows of
+/// the LCPs: a motor on the same joint has the same row, and the two together make the
+/// LCP's matrix singular.
+fn hold_stops(j: &mut JointConstraint, bodies: &mut [SolverBody], dt: f64) {
+    let Some(limits) = j.limits else {
+        return;
+    };
+    let (ia, ib) = (j.body_a as usize, j.body_b as usize);
+    let k = bodies[ia].inv_inertia + bodies[ib].inv_inertia;
+    if k == 0.0 {
+        return;
+    }
+    let theta = bodies[ib].angle - bodies[ia].angle - j.reference_angle;
+    let (at_most, at_least) = limits.spin_bounds(theta, dt);
+    let relative =
+        |bodies: &[SolverBody]| bodies[ia].angular_velocity - bodies[ib].angular_velocity;
+    let push = |bodies: &mut [SolverBody], delta: f64| {
+        bodies[ia].angular_velocity += delta * bodies[ia].inv_inertia;
+        bodies[ib].angular_velocity -= delta * bodies[ib].inv_inertia;
+    };
+    let (lower, upper) = j.limit_impulse;
+    let mut lower_total = lower - (relative(bodies) - at_most) / k;
+    if !limits.is_weld() {
+        lower_total = lower_total.min(0.0);
+    }
+    push(bodies, lower_total - lower);
+    let mut upper_total = upper;
+    if !limits.is_weld() {
+        upper_total = (upper - (relative(bodies) - at_least) / k).max(0.0);
+        push(bodies, upper_total - upper);
+    }
+    j.limit_impulse = (lower_total, upper_total);
+}
+
+/// The stops' last word on an island, after the motors' hold: a few sweeps of
+/// `hold_stops`.
+fn hold_island_stops(island: &mut [JointConstraint], bodies: &mut [SolverBody], dt: f64) {
+    if island.iter().all(|j| j.limits.is_none()) {
+        return;
+    }
+    for _ in 0..4 {
+        for j in island.iter_mut() {
+            hold_stops(j, bodies, dt);
         }
     }
 }
@@ -309,6 +343,7 @@ impl JointBlockSolver {
                     drive_motors_continue(island, bodies, dt, 10, !motors_started);
                 }
                 correct_positions(island, bodies, dt, it);
+                hold_island_stops(island, bodies, dt);
                 return;
             }
             let outer = if has_motor { 8 } else { 1 };
@@ -330,6 +365,7 @@ impl JointBlockSolver {
                 if pin_island.close_gaps(island, bodies, dt, it) {
                     motor_speeds.hold(island, bodies, dt);
                 }
+                hold_island_stops(island, bodies, dt);
             }
         });
     }

@@ -417,7 +417,6 @@ impl SimultaneousSolver {
                         m.last_impulse = x;
                     }
                 }
-                RowKind::JointLimit(_) => {}
                 RowKind::JointX(k) => {
                     joints[self.joint_slots[k as usize] as usize].impulse.x += x;
                 }

@@ -7,7 +7,7 @@
 use crate::math::{Vec2, cross};
 use crate::solver::SolverBody;
 use crate::solver::contact::Contact;
-use crate::solver::joint::{JointConstraint, JointLimits};
+use crate::solver::joint::JointConstraint;
 use crate::solver::lcp::{FrictionBound, LcpProblem, LcpSolver, LcpStats};
 
 /// One body's part of a row: the row's velocity is `linear·v + angular·ω` summed over both.
@@ -28,8 +28,6 @@ pub(crate) enum RowKind {
     JointX(u32),
     JointY(u32),
     JointMotor(u32),
-    /// A stop of joint k on its angle (`JointLimits`): one row each, one for a weld.
-    JointLimit(u32),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -234,54 +232,6 @@ pub(crate) fn velocity_rows(
             row.b = row.velocity(bodies) - m.drive_speed();
             rows.push(row);
         }
-        if let Some(limits) = j.limits {
-            limit_rows(k as u32, j, &limits, bodies, targets.dt, rows);
-        }
-    }
-}
-
-/// A joint's stops as rows on s = ω_A − ω_B: s ≤ the lower stop's bound with an impulse
-/// ≤ 0, s ≥ the upper's with one ≥ 0; a weld, one row held to its bound both ways.
-fn limit_rows(
-    k: u32,
-    j: &JointConstraint,
-    limits: &JointLimits,
-    bodies: &[SolverBody],
-    dt: f64,
-    rows: &mut Vec<Row>,
-) {
-    let theta =
-        bodies[j.body_b as usize].angle - bodies[j.body_a as usize].angle - j.reference_angle;
-    let (at_most, at_least) = limits.spin_bounds(theta, dt);
-    let ends = [
-        RowEnd {
-            body: j.body_a,
-            linear: Vec2::zeros(),
-            angular: 1.0,
-        },
-        RowEnd {
-            body: j.body_b,
-            linear: Vec2::zeros(),
-            angular: -1.0,
-        },
-    ];
-    let row = |target: f64, lo: f64, hi: f64| {
-        let mut row = Row {
-            kind: RowKind::JointLimit(k),
-            ends,
-            b: 0.0,
-            lo,
-            hi,
-            friction_of: None,
-        };
-        row.b = row.velocity(bodies) - target;
-        row
-    };
-    if limits.is_weld() {
-        rows.push(row(at_most, f64::NEG_INFINITY, f64::INFINITY));
-    } else {
-        rows.push(row(at_most, f64::NEG_INFINITY, 0.0));
-        rows.push(row(at_least, 0.0, f64::INFINITY));
     }
 }
 

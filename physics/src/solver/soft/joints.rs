@@ -252,15 +252,8 @@ pub(super) fn warm_start_pin(bodies: &mut [SoftBody], j: &SoftJoint) {
     SoftStepSolver::apply(bodies, j.a, j.b, ra, rb, j.impulse);
 }
 
-/// A joint motor: the relative spin driven towards its target, within ±max torque·h;
-/// then the joint's stops (`solve_limits`).
-pub(super) fn solve_motor(
-    bodies: &mut [SoftBody],
-    j: &mut SoftJoint,
-    h: f64,
-    soft: &Softness,
-    use_bias: bool,
-) {
+/// A joint motor: the relative spin driven towards its target, within ±max torque·h.
+pub(super) fn solve_motor(bodies: &mut [SoftBody], j: &mut SoftJoint, h: f64) {
     if let Some((target, max_torque)) = j.motor {
         let (a, b) = (bodies[j.a as usize], bodies[j.b as usize]);
         let k = a.inv_inertia + b.inv_inertia;
@@ -273,16 +266,15 @@ pub(super) fn solve_motor(
             bodies[j.b as usize].w -= b.inv_inertia * delta;
         }
     }
-    if j.limits.is_some() {
-        solve_limits(bodies, j, h, soft, use_bias);
-    }
 }
 
 /// A joint's stops, as Box2D v3 solves a revolute joint's limits: a stop ahead lets the
 /// joint reach it in the substep (speculative, rigid); one passed is pushed back softly
 /// (the pins' softness) in the biased pass and only held in the relaxing one. Each
-/// stop's accumulated impulse stays one-signed; a weld's is free.
-fn solve_limits(
+/// stop's accumulated impulse stays one-signed; a weld's is free. Solved after the pins,
+/// so that theirs is not the last word: a pin between bodies 5,000:1 apart swings the
+/// light one's spin by hundreds of rad/s within a pass, past a stop solved before it.
+pub(super) fn solve_limits(
     bodies: &mut [SoftBody],
     j: &mut SoftJoint,
     h: f64,

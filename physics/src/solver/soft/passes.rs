@@ -6,7 +6,7 @@ use super::batch::{AskedFor, LaneBatch, LanePath, ManifoldBatch, PassItem, PassS
 use super::bodies::SoftBody;
 use super::constraints::PointConstraint;
 use super::contacts::{solve_pair, solve_point, warm_start_point};
-use super::joints::{solve_joint, solve_motor, warm_start_motor, warm_start_pin};
+use super::joints::{solve_joint, solve_limits, solve_motor, warm_start_motor, warm_start_pin};
 use super::pins::{PinPass, PinPlan};
 use super::settings::{MAX_TURN_PER_SUBSTEP, SoftSettings, Softness, contact_pass};
 use super::{SoftStepSolver, SweepOrder};
@@ -203,8 +203,6 @@ impl SoftStepSolver {
                 &mut self.loaded.bodies,
                 &mut self.pins.joints[k as usize],
                 h,
-                joint_soft,
-                use_bias,
             );
         }
         for (index, &(start, end)) in self.pins.joint_islands.iter().enumerate() {
@@ -236,6 +234,12 @@ impl SoftStepSolver {
         for &k in self.pins.pin_plan.alone() {
             let j = &mut self.pins.joints[k as usize];
             solve_joint(&mut self.loaded.bodies, j, joint_soft, joint_push, use_bias);
+        }
+        for &k in &self.pins.motor_joints {
+            let j = &mut self.pins.joints[k as usize];
+            if j.limits.is_some() {
+                solve_limits(&mut self.loaded.bodies, j, h, joint_soft, use_bias);
+            }
         }
         let pass = contact_pass(h, contact_soft, settings, use_bias);
         self.contact_lcp
