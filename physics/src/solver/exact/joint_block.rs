@@ -140,13 +140,13 @@ fn hold_stops(j: &mut JointConstraint, bodies: &mut [SolverBody], dt: f64) {
     j.limit_impulse = (lower_total, upper_total);
 }
 
-/// The stops' last word on an island, after the motors' hold: a few sweeps of
-/// `hold_stops`.
+/// The stops' last word on an island, after the motors' hold: sweeps of `hold_stops`
+/// (two stops coupled through a body, a double pendulum's, take a dozen to settle).
 fn hold_island_stops(island: &mut [JointConstraint], bodies: &mut [SolverBody], dt: f64) {
     if island.iter().all(|j| j.limits.is_none()) {
         return;
     }
-    for _ in 0..4 {
+    for _ in 0..16 {
         for j in island.iter_mut() {
             hold_stops(j, bodies, dt);
         }
