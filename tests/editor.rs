@@ -167,15 +167,69 @@ fn new_item(h: &mut Harness<'_, RoboSimApp>, kind: &str) {
     click(h, kind);
 }
 
+/// Drags the rotate handle at screen point `handle`, straight above `origin`, `sweep`
+/// degrees about `origin` (clockwise on screen: y down, the turn's positive sense) in
+/// `moves` moves, each followed by a frame with the pointer at rest, as a real mouse
+/// gives.
+fn sweep_handle(
+    h: &mut Harness<'_, RoboSimApp>,
+    origin: Pos2,
+    handle: Pos2,
+    sweep: f32,
+    moves: usize,
+) {
+    let radius = origin.y - handle.y;
+    let at = |degrees: f32| {
+        let a = degrees.to_radians();
+        origin + egui::vec2(radius * a.sin(), -radius * a.cos())
+    };
+    h.event(Event::PointerMoved(handle));
+    h.run_steps(1);
+    h.event(primary_button(at(0.0), true, Modifiers::NONE));
+    h.run_steps(1);
+    for k in 1..=moves {
+        h.event(Event::PointerMoved(at(sweep * k as f32 / moves as f32)));
+        h.run_steps(2);
+    }
+    release(h, at(sweep), Modifiers::NONE);
+}
+
+/// A new body made with New → body; its name.
+fn new_body_selected(h: &mut Harness<'_, RoboSimApp>) -> String {
+    new_item(h, "body");
+    match h.state().selection() {
+        Some(Selection::Body(name)) => name.clone(),
+        other => panic!("a new body is selected, not {other:?}"),
+    }
+}
+
+/// Ctrl+C pressed (the key going down alone, so that the frame it is read in is the last
+/// one run); the text the app put on the system clipboard.
+fn copy_to_clipboard(h: &mut Harness<'_, RoboSimApp>) -> String {
+    h.event(Event::Key {
+        key: Key::C,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: Modifiers::COMMAND,
+    });
+    h.run_steps(1);
+    h.output()
+        .platform_output
+        .commands
+        .iter()
+        .find_map(|c| match c {
+            egui::OutputCommand::CopyText(text) => Some(text.clone()),
+            _ => None,
+        })
+        .expect("text on the clipboard")
+}
+
 #[test]
 fn a_body_drawn_by_clicks_is_saved_and_found_again() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    new_item(&mut h, "body");
-    let name = match h.state().selection() {
-        Some(Selection::Body(name)) => name.clone(),
-        other => panic!("a new body is selected, not {other:?}"),
-    };
+    let name = new_body_selected(&mut h);
     click(&mut h, "Clear and draw");
     assert!(h.state().model().body(&name).unwrap().vertices.is_empty());
     for (x, y) in [(-15.0, -10.0), (15.0, -10.0), (15.0, 10.0), (-15.0, 10.0)] {

@@ -149,11 +149,7 @@ fn the_body_editor_keeps_its_view_while_an_outline_is_drawn() {
 fn a_regular_polygon_is_written_clean_and_a_cleared_body_is_named_once() {
     let dir = scratch_db();
     let mut h = harness(dir.path());
-    new_item(&mut h, "body");
-    let name = match h.state().selection() {
-        Some(Selection::Body(name)) => name.clone(),
-        other => panic!("a new body is selected, not {other:?}"),
-    };
+    let name = super::new_body_selected(&mut h);
     click(&mut h, "Regular polygon");
     let vertices = h.state().model().body(&name).unwrap().vertices.clone();
     assert!(vertices.len() >= 3);

@@ -7,9 +7,9 @@
 use super::chooser::retype;
 use super::{
     body_origin, click, click_world, drag_world, harness, harness_with_files, new_item,
-    press_and_move, primary_button, release, stop_at_step_0, type_into,
+    press_and_move, release, stop_at_step_0, type_into,
 };
-use egui::{Key, Modifiers, Pos2};
+use egui::{Modifiers, Pos2};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use robosim::app::files::{Answer, Scripted};
@@ -56,22 +56,7 @@ fn turn_by_handle(h: &mut Harness<'_, RoboSimApp>, sweep: f32, moves: usize) {
     };
     // The handle stands 24 points above the selection, over the chassis's origin.
     let handle = egui::pos2(origin.x, top - 24.0);
-    let radius = origin.y - handle.y;
-    let at = |degrees: f32| {
-        let a = degrees.to_radians();
-        origin + egui::vec2(radius * a.sin(), -radius * a.cos())
-    };
-    h.event(egui::Event::PointerMoved(handle));
-    h.run_steps(1);
-    h.event(primary_button(at(0.0), true, Modifiers::NONE));
-    h.run_steps(1);
-    for k in 1..=moves {
-        h.event(egui::Event::PointerMoved(at(
-            sweep * k as f32 / moves as f32
-        )));
-        h.run_steps(2);
-    }
-    release(h, at(sweep), Modifiers::NONE);
+    super::sweep_handle(h, origin, handle, sweep, moves);
 }
 
 #[test]
@@ -220,24 +205,7 @@ fn a_new_user_builds_a_car_drives_it_turns_copies_and_saves_it_without_a_file_di
     );
 
     // Ctrl+C puts the rover on the clipboard as text; Ctrl+V pastes it in free space.
-    h.event(egui::Event::Key {
-        key: Key::C,
-        physical_key: None,
-        pressed: true,
-        repeat: false,
-        modifiers: Modifiers::COMMAND,
-    });
-    h.run_steps(1);
-    let copied = h
-        .output()
-        .platform_output
-        .commands
-        .iter()
-        .find_map(|c| match c {
-            egui::OutputCommand::CopyText(text) => Some(text.clone()),
-            _ => None,
-        })
-        .expect("the rover's text on the clipboard");
+    let copied = super::copy_to_clipboard(&mut h);
     h.run_steps(1);
     h.event(egui::Event::Paste(copied));
     h.run_steps(2);

@@ -1,10 +1,7 @@
 //! Rubber-band selection at step 0 and the edits that apply to every selected placement
 //! at once, each one undo step.
 
-use super::{
-    click_world, drag_world, drag_world_holding, harness, open_at_step_0, primary_button, release,
-    scratch_db,
-};
+use super::{click_world, drag_world, drag_world_holding, harness, open_at_step_0, scratch_db};
 use egui::{Key, Modifiers};
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -256,27 +253,9 @@ fn the_rotate_handle_turns_by_the_angle_swept() {
     let origin = camera.to_screen(rect, pe::Vec2::new(400.0, 305.0));
     // The handle: 24 points above the top of the outline (y = 290).
     let handle = camera.to_screen(rect, pe::Vec2::new(400.0, 290.0)) - egui::vec2(0.0, 24.0);
-    let radius = origin.y - handle.y;
     for (sweep, moves) in [(45f32, 4), (90f32, 10)] {
         let before = body(&stack(&h), "box 3").orientation;
-        let at = |degrees: f32| {
-            // Clockwise on screen from straight up (y down: the turn's positive sense).
-            let a = degrees.to_radians();
-            origin + egui::vec2(radius * a.sin(), -radius * a.cos())
-        };
-        h.event(egui::Event::PointerMoved(handle));
-        h.run_steps(1);
-        h.event(primary_button(at(0.0), true, Modifiers::NONE));
-        h.run_steps(1);
-        for k in 1..=moves {
-            h.event(egui::Event::PointerMoved(at(
-                sweep * k as f32 / moves as f32
-            )));
-            h.run_steps(1);
-            // A frame with the pointer at rest between moves, as a real mouse gives.
-            h.run_steps(1);
-        }
-        release(&mut h, at(sweep), Modifiers::NONE);
+        super::sweep_handle(&mut h, origin, handle, sweep, moves);
         let turned = body(&stack(&h), "box 3").orientation - before;
         assert!(
             (turned - f64::from(sweep).to_radians()).abs() < 0.5f64.to_radians(),
@@ -313,25 +292,7 @@ fn copied_placements_go_on_the_system_clipboard_and_paste_in_another_window() {
     let dir = scratch_db();
     let mut h = stack_at_step_0(dir.path());
     pick_three(&mut h);
-    // The key going down alone, so that the frame it is read in is the last one run.
-    h.event(egui::Event::Key {
-        key: Key::C,
-        physical_key: None,
-        pressed: true,
-        repeat: false,
-        modifiers: Modifiers::COMMAND,
-    });
-    h.run_steps(1);
-    let copied = h
-        .output()
-        .platform_output
-        .commands
-        .iter()
-        .find_map(|c| match c {
-            egui::OutputCommand::CopyText(text) => Some(text.clone()),
-            _ => None,
-        })
-        .expect("the placements' text on the clipboard");
+    let copied = super::copy_to_clipboard(&mut h);
     assert!(
         copied.contains("robosim clipboard") && copied.contains("box 3"),
         "{copied}"
