@@ -560,8 +560,8 @@ impl World {
         self.bodies().map(|(_, b)| b.kinetic_energy()).sum()
     }
 
-    /// Potential energy in the uniform gravity field, zero at the world origin.
-    /// Gravity's potential energy and the joint springs': ½·k·(θ − rest)² each.
+    /// Potential energy: in the uniform gravity field (zero at the world origin), and in
+    /// the joint springs (½·k·(θ − rest)² each).
     pub fn potential_energy(&self) -> f64 {
         let gravity: f64 = self
             .bodies()
