@@ -794,6 +794,13 @@ fn plots_show_one_unit_per_axis_with_readable_numbers_and_export_to_csv() {
         "{}",
         h.state().status()
     );
+    // Every joint's angle and spin (issue 65): the car's wheels turn forward against the
+    // chassis, clockwise on screen, at up to their motors' 6 rad/s.
+    let column = |name: &str| header.split(',').position(|h| h == name).expect(name);
+    let spin = column("spin car#0/chassis-rear (rad/s)");
+    column("angle car#0/chassis-rear (rad)");
+    let last_spin: f64 = rows[rows.len() - 1].split(',').nth(spin).unwrap().parse().unwrap();
+    assert!(last_spin > 0.5 && last_spin <= 6.0 + 1e-6, "{last_spin}");
 }
 
 #[test]

@@ -15,6 +15,8 @@ pub struct Sample {
     pub bodies: Vec<(u32, BodyState)>,
     /// Every motor's torque, in `Simulation::motor_torques` order.
     pub torques: Vec<f64>,
+    /// Every joint's angle θ (0 as placed) and spin ω_B − ω_A, in `sim.joints` order.
+    pub joints: Vec<(f64, f64)>,
 }
 
 /// A body's reference point, angle and velocities: x, y, angle, vx, vy, ω.
@@ -30,6 +32,8 @@ pub const EVERY_BODY_LIMIT: usize = 32;
 pub struct PlotData {
     pub samples: Vec<Sample>,
     pub motor_names: Vec<String>,
+    /// The joints' trace ids, in `Sample::joints` order.
+    pub joint_names: Vec<String>,
     /// The body the plots and the CSV show (index into `sim.bodies`).
     pub shown_body: Option<usize>,
 }
@@ -40,6 +44,7 @@ impl PlotData {
     pub fn clear(&mut self) {
         self.samples.clear();
         self.motor_names.clear();
+        self.joint_names.clear();
     }
 
     /// Shows body `body` from now on; its series from step 0 where every body is kept.
@@ -60,6 +65,25 @@ impl PlotData {
         if self.motor_names.len() != torques.len() {
             self.motor_names = torques.iter().map(|t| t.id.clone()).collect();
         }
+        if self.joint_names.len() != sim.joints.len() {
+            self.joint_names = sim.joints.iter().map(|j| j.id.clone()).collect();
+        }
+        let spin = |h: Option<pe::BodyHandle>| {
+            h.and_then(|h| sim.world.body(h))
+                .map_or(0.0, |b| b.angular_velocity)
+        };
+        let joints = sim
+            .joints
+            .iter()
+            .map(|j| {
+                let joint = sim.world.joint(j.handle);
+                let angle = sim.world.joint_angle(j.handle).unwrap_or(f64::NAN);
+                let relative = joint.map_or(f64::NAN, |joint| {
+                    spin(joint.body_b) - spin(Some(joint.body_a))
+                });
+                (angle, relative)
+            })
+            .collect();
         let state = |i: usize| {
             let b = sim.world.body(sim.bodies.get(i)?.handle)?;
             let origin = b.origin();
@@ -81,6 +105,7 @@ impl PlotData {
             max_joint_gap: metrics.max_joint_gap,
             bodies,
             torques: torques.iter().map(|t| t.torque).collect(),
+            joints,
         });
         if self.samples.len() > CAPACITY {
             let mut keep = 0;

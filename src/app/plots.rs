@@ -54,6 +54,10 @@ pub enum MotorQuantity {
     #[default]
     Torque,
     JointGap,
+    /// Every joint's angle θ, 0 as placed (where its stops and servos act).
+    JointAngle,
+    /// Every joint's spin ω_B − ω_A (what its motor drives).
+    JointSpin,
 }
 
 impl MotorQuantity {
@@ -61,8 +65,17 @@ impl MotorQuantity {
         match self {
             Self::Torque => format!("motor torques ({ENERGY})"),
             Self::JointGap => format!("widest joint gap ({LENGTH})"),
+            Self::JointAngle => "joint angles (rad)".to_string(),
+            Self::JointSpin => "joint spins, B against A (rad/s)".to_string(),
         }
     }
+
+    const ALL: [Self; 4] = [
+        Self::Torque,
+        Self::JointGap,
+        Self::JointAngle,
+        Self::JointSpin,
+    ];
 }
 
 /// What the plots panel asks the app to do.
@@ -117,12 +130,14 @@ impl PlotsPanel {
             egui::ComboBox::from_id_salt("motor quantity")
                 .selected_text(self.motors.label())
                 .show_ui(&mut cols[2], |ui| {
-                    for q in [MotorQuantity::Torque, MotorQuantity::JointGap] {
+                    for q in MotorQuantity::ALL {
                         ui.selectable_value(&mut self.motors, q, q.label());
                     }
                 })
                 .response
-                .on_hover_text("The motors' torques, or the widest joint gap");
+                .on_hover_text(
+                    "The motors' torques, the widest joint gap, or every joint's angle or spin",
+                );
             motor_plot(&mut cols[2], data, self.motors);
         });
         command
@@ -185,6 +200,26 @@ fn motor_plot(ui: &mut egui::Ui, data: &PlotData, quantity: MotorQuantity) {
                 data.series(|s| Some(s.max_joint_gap)),
             )];
             plot("joint gap", ui, data, LENGTH, lines);
+        }
+        MotorQuantity::JointAngle | MotorQuantity::JointSpin => {
+            let (id, unit) = match quantity {
+                MotorQuantity::JointAngle => ("joint angles", "rad"),
+                _ => ("joint spins", "rad/s"),
+            };
+            let pick = |j: (f64, f64)| match quantity {
+                MotorQuantity::JointAngle => j.0,
+                _ => j.1,
+            };
+            let lines = data
+                .joint_names
+                .iter()
+                .enumerate()
+                .map(|(k, name)| {
+                    let values = data.series(|s| s.joints.get(k).map(|&j| pick(j)));
+                    (name.clone(), values)
+                })
+                .collect();
+            plot(id, ui, data, unit, lines);
         }
     }
 }
@@ -309,6 +344,10 @@ pub fn to_csv(data: &PlotData) -> String {
     for name in &data.motor_names {
         header.push(format!("torque {name} ({ENERGY})"));
     }
+    for name in &data.joint_names {
+        header.push(format!("angle {name} (rad)"));
+        header.push(format!("spin {name} (rad/s)"));
+    }
     let mut out = String::new();
     let quote = |field: &str| {
         if field.contains([',', '"', '\n']) {
@@ -330,7 +369,13 @@ pub fn to_csv(data: &PlotData) -> String {
         .first()
         .map_or((0.0, 0.0), |s| (s.kinetic, s.potential));
     for s in &data.samples {
-        let row = row(s, start, data.shown_state(s), data.motor_names.len());
+        let row = row(
+            s,
+            start,
+            data.shown_state(s),
+            data.motor_names.len(),
+            data.joint_names.len(),
+        );
         out.push_str(&row.join(","));
         out.push('\n');
     }
@@ -339,7 +384,13 @@ pub fn to_csv(data: &PlotData) -> String {
 
 /// One sample as the plots show it: energies as in the energy plot (potential and total
 /// since step 0, whose energies are `start`), the shown body's state, the torques.
-fn row(s: &Sample, (k0, p0): (f64, f64), body: Option<BodyState>, motors: usize) -> Vec<String> {
+fn row(
+    s: &Sample,
+    (k0, p0): (f64, f64),
+    body: Option<BodyState>,
+    motors: usize,
+    joints: usize,
+) -> Vec<String> {
     let mut row = vec![
         s.time.to_string(),
         s.kinetic.to_string(),
@@ -352,6 +403,12 @@ fn row(s: &Sample, (k0, p0): (f64, f64), body: Option<BodyState>, motors: usize)
         None => row.extend(std::iter::repeat_n(String::new(), 6)),
     }
     row.extend((0..motors).map(|k| s.torques.get(k).map_or(String::new(), |t| t.to_string())));
+    for k in 0..joints {
+        match s.joints.get(k) {
+            Some((angle, spin)) => row.extend([angle.to_string(), spin.to_string()]),
+            None => row.extend([String::new(), String::new()]),
+        }
+    }
     row
 }
 
