@@ -68,11 +68,37 @@ pub struct JointMotorDef {
     /// (θ = 0 as placed) to this at no more than |angular| a step, with at most
     /// maxTorque, and holding it there.
     pub target_angle: Option<f64>,
+    /// Extension (attribute `keys`, two names: `keys="Left Right"`): the motor runs only
+    /// while one of its keys is held in the app, at −angular for the first, +angular for
+    /// the second (within its window). Names: `Left`, `Right`, `Up`, `Down`, a letter
+    /// `A`–`Z` or a digit `0`–`9` (see `motor_key_names`).
+    pub keys: Option<[String; 2]>,
     pub extra: ExtraAttributes,
     pub location: Location,
 }
 
+/// The key names a motor may be bound to (`JointMotorDef::keys`).
+pub fn is_motor_key_name(name: &str) -> bool {
+    matches!(name, "Left" | "Right" | "Up" | "Down")
+        || (name.len() == 1
+            && name
+                .chars()
+                .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit()))
+}
+
 impl JointMotorDef {
+    /// The speed (radians per step) the motor drives at during `step` with its keys in
+    /// `drive` (−1 first key held, 1 second, 0 none; ignored for a motor without keys);
+    /// None outside its window, or with none of its keys held.
+    pub fn angular_driven_at(&self, step: u64, drive: i8) -> Option<f64> {
+        let angular = self.angular_at(step)?;
+        match (&self.keys, drive) {
+            (None, _) => Some(angular),
+            (Some(_), 0) => None,
+            (Some(_), d) => Some(f64::from(d.signum()) * angular),
+        }
+    }
+
     /// The speed (radians per step) the motor drives at during `step`; None outside its
     /// window.
     pub fn angular_at(&self, step: u64) -> Option<f64> {

@@ -799,7 +799,12 @@ fn plots_show_one_unit_per_axis_with_readable_numbers_and_export_to_csv() {
     let column = |name: &str| header.split(',').position(|h| h == name).expect(name);
     let spin = column("spin car#0/chassis-rear (rad/s)");
     column("angle car#0/chassis-rear (rad)");
-    let last_spin: f64 = rows[rows.len() - 1].split(',').nth(spin).unwrap().parse().unwrap();
+    let last_spin: f64 = rows[rows.len() - 1]
+        .split(',')
+        .nth(spin)
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(last_spin > 0.5 && last_spin <= 6.0 + 1e-6, "{last_spin}");
 }
 
@@ -1020,14 +1025,12 @@ fn the_inspector_keeps_its_width_when_a_joint_is_opened() {
     h.get_by_label("walker · 3 bodies, 2 joints").click();
     h.run_steps(3);
     let canvas = h.state().canvas_rect().width();
-    for header in ["body – rear leg", "body – front leg"] {
-        h.get_by_label(header).click();
-        h.run_steps(3);
-    }
+    h.get_by_label("body – rear leg").click();
+    h.run_steps(3);
     assert_eq!(
         h.query_all_by_label("swing period").count(),
-        2,
-        "both motors shown"
+        1,
+        "its motor shown"
     );
     assert_eq!(
         h.state().canvas_rect().width(),

@@ -741,3 +741,51 @@ fn joint_stops_from_the_files_hold_the_pendulum_within_them() {
         .unwrap();
     assert!(refused.to_string().contains("lowerAngle"), "{refused}");
 }
+
+/// Keys per motor (issue 65): the keyboard car's motors run only while a key is held,
+/// forward for the second key (Right), backward for the first (Left).
+#[test]
+fn the_keyboard_car_drives_only_while_a_key_is_held() {
+    let model = model();
+    let mut sim = Simulation::new(&model, "drive with the arrow keys", None, None).unwrap();
+    let chassis_x = |sim: &Simulation| {
+        let b = sim
+            .bodies
+            .iter()
+            .find(|b| b.id.ends_with("/chassis"))
+            .unwrap();
+        sim.world.body(b.handle).unwrap().position.x
+    };
+    let run = |sim: &mut Simulation, drive: i8, steps: usize| {
+        for j in &mut sim.joints {
+            j.drive = drive;
+        }
+        let start = chassis_x(sim);
+        for _ in 0..steps {
+            sim.try_step().unwrap();
+        }
+        chassis_x(sim) - start
+    };
+    // Let it settle on its wheels, no key held: it stays.
+    let idle = run(&mut sim, 0, 120);
+    assert!(idle.abs() < 1.0, "no key, no drive: moved {idle}");
+    let forward = run(&mut sim, 1, 120);
+    assert!(forward > 50.0, "Right held: drove {forward}");
+    let back = run(&mut sim, -1, 240);
+    assert!(back < -50.0, "Left held: drove {back}");
+
+    let mut model = model;
+    let car = model
+        .robots
+        .iter_mut()
+        .find(|r| r.name == "keyboard car")
+        .unwrap();
+    car.joints[0].motor.as_mut().unwrap().keys = Some(["Left".into(), "Left".into()]);
+    let problems = robosim::db::check(&model, |k| format!("{k:?}.xml"));
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.to_string().contains("is not two different keys")),
+        "{problems:#?}"
+    );
+}

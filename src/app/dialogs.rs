@@ -137,7 +137,9 @@ fn question(dialog: &Dialog) -> (String, Vec<Answer>) {
 }
 
 /// The shortcut sheet: every shortcut of `shortcuts::SHORTCUTS`, and the mouse.
-pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
+/// Every shortcut, the mouse's gestures, and the keys the shown scene's motors are bound
+/// to (`motor_keys`: each motor's name and its two keys).
+pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool, motor_keys: &[(String, [String; 2])]) {
     if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
         *open = false;
         return;
@@ -174,12 +176,15 @@ pub fn shortcut_sheet(ctx: &egui::Context, open: &mut bool) {
                         ui.label(what);
                         ui.end_row();
                     }
+                    for (motor, [back, forth]) in motor_keys {
+                        ui.monospace(format!("{back} / {forth}"));
+                        ui.label(format!("While running: hold to drive {motor} back / forth"));
+                        ui.end_row();
+                    }
                 });
         });
 }
 
-/// The user guide (docs/user-guide.md, compiled in), as its text: always at hand, with
-/// no browser and no network.
 /// docs/user-guide.md in a window, its Markdown drawn (headings, lists, tables, links);
 /// its screenshots left out (the window shows the app itself).
 pub fn user_guide(

@@ -650,7 +650,18 @@ impl RoboSimApp {
             status::problems_window(ctx, self.doc.problems(), &mut self.show_problems);
         }
         if self.show_shortcuts {
-            dialogs::shortcut_sheet(ctx, &mut self.show_shortcuts);
+            let motor_keys: Vec<(String, [String; 2])> = self
+                .runner
+                .sim()
+                .map(|sim| {
+                    let bound = |j: &crate::sim::SimJoint| {
+                        let keys = j.motor.as_ref()?.keys.clone()?;
+                        Some((j.id.clone(), keys))
+                    };
+                    sim.joints.iter().filter_map(bound).collect()
+                })
+                .unwrap_or_default();
+            dialogs::shortcut_sheet(ctx, &mut self.show_shortcuts, &motor_keys);
         }
         if self.show_guide {
             dialogs::user_guide(ctx, &mut self.show_guide, &mut self.guide_markdown);
@@ -669,6 +680,29 @@ impl RoboSimApp {
                 });
         }
         commands
+    }
+
+    /// Sets each key-bound joint motor's drive from the keys held (the first: −1, the
+    /// second: +1); returns the keys bound, which shortcuts then leave alone.
+    fn drive_motors_by_keys(&mut self, ui: &egui::Ui) -> Vec<egui::Key> {
+        let Some(sim) = self.runner.sim_mut() else {
+            return Vec::new();
+        };
+        let mut bound = Vec::new();
+        for j in &mut sim.joints {
+            let Some([first, second]) = j.motor.as_ref().and_then(|m| m.keys.clone()) else {
+                continue;
+            };
+            let (Some(back), Some(forth)) =
+                (egui::Key::from_name(&first), egui::Key::from_name(&second))
+            else {
+                continue;
+            };
+            let (back_held, forth_held) = ui.input(|i| (i.key_down(back), i.key_down(forth)));
+            j.drive = i8::from(forth_held) - i8::from(back_held);
+            bound.extend([back, forth]);
+        }
+        bound
     }
 
     /// The unsaved-changes guard on closing the window.
@@ -711,7 +745,13 @@ impl eframe::App for RoboSimApp {
                 })
             })
             .flatten();
-        let actions = ui.input_mut(|i| shortcuts::pressed(i, typing, tool_on));
+        // While a scene runs, the keys its motors are bound to drive them, not shortcuts.
+        let motor_keys = if self.runner.running && !typing {
+            self.drive_motors_by_keys(ui)
+        } else {
+            Vec::new()
+        };
+        let actions = ui.input_mut(|i| shortcuts::pressed(i, typing, tool_on, &motor_keys));
         for action in actions {
             if let Some(command) = self.action(action) {
                 self.apply(command, &ctx, now);

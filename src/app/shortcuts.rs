@@ -149,11 +149,20 @@ pub fn of(action: Action) -> Option<KeyboardShortcut> {
 /// The actions pressed this frame, consumed so that no widget also sees them. While a text
 /// field has the focus, keys without Ctrl type into it and Ctrl+Z/Y undo the typing.
 /// Escape is taken only while a tool other than select is on (`tool_on`): otherwise it
-/// stays egui's, which closes menus and popups with it.
-pub fn pressed(input: &mut egui::InputState, typing: bool, tool_on: bool) -> Vec<Action> {
+/// stays egui's, which closes menus and popups with it. Keys in `motor_keys` (bound to
+/// the running scene's motors) are no plain shortcut's.
+pub fn pressed(
+    input: &mut egui::InputState,
+    typing: bool,
+    tool_on: bool,
+    motor_keys: &[Key],
+) -> Vec<Action> {
     let mut actions = Vec::new();
     for (action, shortcut, _) in SHORTCUTS {
         if *action == Action::SelectTool && !tool_on {
+            continue;
+        }
+        if !shortcut.modifiers.command && motor_keys.contains(&shortcut.logical_key) {
             continue;
         }
         let needs_command = shortcut.modifiers.command;

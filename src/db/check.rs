@@ -146,6 +146,16 @@ pub fn joint_motor_problems(m: &JointMotorDef) -> Vec<String> {
         m.target_angle.unwrap_or(0.0),
         limits::ANGLE,
     )]));
+    if let Some([first, second]) = &m.keys {
+        let named = |k: &str| crate::model::is_motor_key_name(k);
+        if !named(first) || !named(second) || first == second {
+            out.push(format!(
+                "keys=\"{} {}\" is not two different keys of Left, Right, Up, Down, A–Z, 0–9",
+                clip(first),
+                clip(second)
+            ));
+        }
+    }
     out.extend(beyond_all(&[
         ("angular", m.angular, limits::ANGULAR),
         ("maxTorque", m.max_torque, limits::TORQUE),

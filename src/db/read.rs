@@ -72,6 +72,10 @@ impl<'a> Fields<'a> {
         }
     }
 
+    fn optional_text(&mut self, key: &'static str) -> Option<String> {
+        self.raw(key).map(str::to_string)
+    }
+
     fn parse_number(&mut self, key: &'static str, value: &str) -> f64 {
         match value.trim().parse::<f64>() {
             Ok(v) if v.is_finite() => v,
@@ -359,6 +363,12 @@ pub fn robots(root: &Element, file: &str) -> Read<Robot> {
                             max_torque: f.number("maxTorque"),
                             period: f.optional_steps("period").unwrap_or(0),
                             target_angle: f.optional_number("targetAngle"),
+                            keys: f.optional_text("keys").map(|k| {
+                                let mut names = k.split_whitespace().map(str::to_string);
+                                let first = names.next().unwrap_or_default();
+                                let rest: Vec<String> = names.collect();
+                                [first, rest.join(" ")]
+                            }),
                             extra: Vec::new(),
                             location: m.location,
                         };

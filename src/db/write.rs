@@ -204,6 +204,9 @@ pub fn robot(r: &Robot, out: &mut String) {
                 if let Some(angle) = m.target_angle {
                     motor = motor.num("targetAngle", angle);
                 }
+                if let Some([first, second]) = &m.keys {
+                    motor = motor.text("keys", &format!("{first} {second}"));
+                }
                 motor.extra(&m.extra).empty(out);
                 out.push_str("    </joint>\n");
             }

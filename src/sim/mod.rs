@@ -43,6 +43,9 @@ pub struct SimJoint {
     pub handle: JointHandle,
     /// The joint's motor as the files give it (its window, speed and swing), if any.
     pub motor: Option<crate::model::JointMotorDef>,
+    /// Which of the motor's keys is held (−1 the first, 1 the second, 0 neither): the
+    /// app's to set; a motor bound to keys runs only while one is.
+    pub drive: i8,
     /// The joint in the files: the scene's `robot`-th `<robot>`, its `joint`-th joint.
     pub defined_by: (usize, usize),
 }
@@ -358,7 +361,7 @@ impl Simulation {
             if let Some(problem) = db::joint_motor_problems(m).into_iter().next() {
                 return Err(format!("{id}: motor: {problem}"));
             }
-            let at_start = m.angular_at(0);
+            let at_start = m.angular_driven_at(0, 0);
             def.motor = Some(JointMotor {
                 target_angle: m.target_angle,
                 enabled: at_start.is_some(),
@@ -376,6 +379,7 @@ impl Simulation {
             id,
             handle,
             motor: joint.motor.clone(),
+            drive: 0,
             defined_by,
         });
         Ok(())
@@ -499,7 +503,7 @@ impl Simulation {
             if let Some(def) = &j.motor
                 && let Some(m) = self.world.joint_motor_mut(j.handle)
             {
-                let angular = def.angular_at(step);
+                let angular = def.angular_driven_at(step, j.drive);
                 m.enabled = angular.is_some();
                 match angular {
                     Some(w) => m.target_speed = self.motor_throttle * pe_joint_speed(w, self.dt),

@@ -49,7 +49,7 @@ fn save_as_without_a_file_dialog_saves_into_a_new_folder_made_in_the_apps_choose
     }
     let (saved, problems) = Database::load(&made);
     assert!(problems.is_empty(), "{problems:?}");
-    assert_eq!(saved.model.scenes.len(), 9);
+    assert_eq!(saved.model.scenes.len(), 10);
     assert!(
         h.state().status().contains("saved to"),
         "{}",

@@ -322,3 +322,49 @@ fn an_edit_that_must_restart_a_run_asks_first() {
     assert_eq!(scene.solver.as_deref(), Some("exact"));
     assert_eq!(h.state().sim().unwrap().step_count(), 0);
 }
+
+/// A motor bound to keys (issue 65) runs while its key is held and the scene runs: the
+/// keyboard car drives right on Right and stays put without it; the shortcut sheet
+/// lists the keys.
+#[test]
+fn held_arrow_keys_drive_the_keyboard_car() {
+    let dir = scratch_db();
+    let mut h = harness(dir.path());
+    open_at_step_0(&mut h, "drive with the arrow keys");
+    let chassis_x = |h: &Harness<'_, RoboSimApp>| {
+        let sim = h.state().sim().unwrap();
+        let b = sim
+            .bodies
+            .iter()
+            .find(|b| b.id.ends_with("/chassis"))
+            .unwrap();
+        sim.world.body(b.handle).unwrap().position.x
+    };
+    click(&mut h, "Play");
+    for _ in 0..30 {
+        h.run_steps(1);
+    }
+    let start = chassis_x(&h);
+    let key = |pressed| Event::Key {
+        key: Key::ArrowRight,
+        physical_key: None,
+        pressed,
+        repeat: false,
+        modifiers: egui::Modifiers::NONE,
+    };
+    h.event(key(true));
+    for _ in 0..90 {
+        h.run_steps(1);
+    }
+    h.event(key(false));
+    h.run_steps(1);
+    let driven = chassis_x(&h) - start;
+    assert!(driven > 30.0, "Right held: drove {driven}");
+    h.key_press(Key::F1);
+    h.run_steps(2);
+    assert_eq!(
+        h.query_all_by_label("Left / Right").count(),
+        2,
+        "both motors listed"
+    );
+}

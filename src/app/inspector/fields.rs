@@ -332,6 +332,7 @@ pub fn joint_fields(
                 );
                 ui.end_row();
                 servo_row(ui, m, key, edit);
+                keys_row(ui, m, key, edit);
             }
         });
 }
@@ -414,6 +415,30 @@ fn spring_rows(ui: &mut Ui, j: &mut JointDef, key: &str, edit: &mut Edit) {
         edit.touched(format!("{key} spring {label}"), ui.add(drag).changed());
         ui.end_row();
     }
+}
+
+/// A joint motor's keys row: two key names (`Left Right`, `A D`); held while the scene
+/// runs, the first drives it backward, the second forward. Empty: no keys, it runs by
+/// its window alone.
+fn keys_row(ui: &mut Ui, m: &mut JointMotorDef, key: &str, edit: &mut Edit) {
+    ui.label("keys").on_hover_text(
+        "Two keys (Left, Right, Up, Down, A-Z, 0-9), e.g. \"Left Right\": while running, the motor drives only while one is held, backward for the first, forward for the second. Empty: it runs by its steps alone",
+    );
+    let mut text = m
+        .keys
+        .as_ref()
+        .map_or(String::new(), |[a, b]| format!("{a} {b}"));
+    let response = ui.add(egui::TextEdit::singleline(&mut text).desired_width(90.0));
+    if response.changed() {
+        let names: Vec<String> = text.split_whitespace().map(str::to_string).collect();
+        m.keys = match names.as_slice() {
+            [] => None,
+            [one] => Some([one.clone(), String::new()]),
+            [first, rest @ ..] => Some([first.clone(), rest.join(" ")]),
+        };
+        edit.touched(format!("{key} keys"), true);
+    }
+    ui.end_row();
 }
 
 /// A joint motor's servo row: on, it drives the joint to an angle and holds it there.
