@@ -13,6 +13,8 @@ const SELECTED: Color32 = Color32::from_rgb(255, 220, 80);
 const TERRAIN: Color32 = Color32::from_rgb(70, 74, 82);
 const CONTACT: Color32 = Color32::from_rgb(240, 90, 60);
 const PIN: Color32 = Color32::from_rgb(255, 160, 40);
+/// A joint's stops (`stops_arc`).
+const STOPS: Color32 = Color32::from_rgb(120, 220, 255);
 
 /// What to draw besides the bodies.
 #[derive(Debug, Clone, Copy)]
@@ -156,6 +158,7 @@ fn joints_and_contacts(
                 shapes.push(Shape::line_segment([a, b], Stroke::new(2.0, Color32::RED)));
                 shapes.push(Shape::circle_stroke(a, 4.0, Stroke::new(1.5, PIN)));
                 shapes.push(Shape::circle_filled(b, 2.0, PIN));
+                stops_arc(shapes, sim, j.handle, a);
             }
         }
     }
@@ -167,6 +170,44 @@ fn joints_and_contacts(
             shapes.push(Shape::line_segment([p, p + n], Stroke::new(1.0, CONTACT)));
         }
     }
+}
+
+/// A joint's stops as an arc about its pin at `at` (screen): the directions body B's x
+/// axis may take (θ from the lower stop to the upper, a turn at most), a tick at each
+/// stop and a line where it points now.
+fn stops_arc(shapes: &mut Vec<Shape>, sim: &Simulation, joint: pe::JointHandle, at: Pos2) {
+    use std::f64::consts::PI;
+    let Some(j) = sim.world.joint(joint) else {
+        return;
+    };
+    let (Some(limits), Some(theta)) = (j.limits, sim.world.joint_angle(joint)) else {
+        return;
+    };
+    let zero = sim.world.body(j.body_a).map_or(0.0, |a| a.angle) + j.reference_angle;
+    let (lower, upper) = (limits.lower.max(-PI), limits.upper.min(PI));
+    let towards = |angle: f64, radius: f32| {
+        let (s, c) = (zero + angle).sin_cos();
+        at + egui::vec2(c as f32, s as f32) * radius
+    };
+    let stroke = Stroke::new(1.5, STOPS);
+    const RADIUS: f32 = 22.0;
+    let segments = ((upper - lower) / (PI / 24.0)).ceil().max(1.0) as usize;
+    let arc: Vec<Pos2> = (0..=segments)
+        .map(|k| towards(lower + (upper - lower) * k as f64 / segments as f64, RADIUS))
+        .collect();
+    shapes.push(Shape::line(arc, stroke));
+    for (stop, kept) in [(lower, limits.lower >= -PI), (upper, limits.upper <= PI)] {
+        if kept {
+            shapes.push(Shape::line_segment(
+                [towards(stop, RADIUS - 4.0), towards(stop, RADIUS + 4.0)],
+                stroke,
+            ));
+        }
+    }
+    shapes.push(Shape::line_segment(
+        [at, towards(theta, RADIUS + 6.0)],
+        stroke,
+    ));
 }
 
 /// Grid lines at a spacing that stays between 25 and 250 screen points at any zoom.
