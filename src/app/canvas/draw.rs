@@ -102,17 +102,23 @@ pub fn scene(
                 Stroke::new(1.0, Color32::from_gray(200)),
             ));
         }
-        body_overlays(&mut shapes, body, debug, &to_screen);
+        // At step 0 a body given a starting velocity shows it (vx, vy, omega).
+        let starts_moving = sim.step_count() == 0
+            && !body.is_static()
+            && (body.velocity.norm() > 0.0 || body.angular_velocity != 0.0);
+        body_overlays(&mut shapes, body, debug, starts_moving, &to_screen);
     }
     joints_and_contacts(&mut shapes, sim, debug, &to_screen);
     shapes
 }
 
-/// Centre of mass, velocity and bounding box of one body, as `debug` asks.
+/// Centre of mass, velocity and bounding box of one body, as `debug` asks; its velocity
+/// also where `starts_moving` (a starting velocity, shown at step 0).
 fn body_overlays(
     shapes: &mut Vec<Shape>,
     body: &pe::Body,
     debug: &DebugDraw,
+    starts_moving: bool,
     to_screen: &impl Fn(Vec2) -> Pos2,
 ) {
     if debug.centres {
@@ -124,7 +130,7 @@ fn body_overlays(
             Stroke::new(1.0, Color32::WHITE),
         ));
     }
-    if debug.velocities && !body.is_static() {
+    if (debug.velocities || starts_moving) && !body.is_static() {
         let c = body.centroid();
         let (from, to) = (to_screen(c), to_screen(c + body.velocity * 0.1));
         let stroke = Stroke::new(1.5, Color32::LIGHT_GREEN);
