@@ -100,13 +100,19 @@ pub fn drawn_shape(
     }
 }
 
+/// `v` to a thousandth, as the editor writes computed numbers (no `-0`: a file would keep
+/// it).
+fn to_thousandth(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0 + 0.0
+}
+
 /// A regular `n`-gon of circumradius `r` about the origin, with a flat edge at the bottom
 /// (+y, down on screen) so that it rests on the ground as drawn; vertices in the order of
 /// the app's other outlines, to a thousandth (no `-0`: a file would keep it).
 pub fn regular_polygon(n: u32, r: f64) -> Vec<[f64; 2]> {
     use std::f64::consts::{FRAC_PI_2, PI, TAU};
     let start = FRAC_PI_2 + PI / n as f64;
-    let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
+    let round = to_thousandth;
     (0..n)
         .map(|k| {
             let a = start + TAU * k as f64 / n as f64;
@@ -305,8 +311,7 @@ pub fn joint_snap_point(model: &Model, robot: &Robot, p: Vec2, radius: f64) -> O
         // To a thousandth, as the editor's other numbers: a centroid found by summing
         // (5.000000000000002 for a hexagon's) would be written as it is.
         let centre = place(polygon.mass_properties().centroid);
-        let round = |v: f64| (v * 1000.0).round() / 1000.0 + 0.0;
-        centres.push(Vec2::new(round(centre.x), round(centre.y)));
+        centres.push(Vec2::new(to_thousandth(centre.x), to_thousandth(centre.y)));
         vertices.extend(polygon.vertices().iter().map(|&v| place(v)));
     }
     let nearest = |points: &[Vec2]| {

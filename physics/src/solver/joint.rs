@@ -122,28 +122,14 @@ impl JointSpring {
 
     /// The angular impulse the spring puts on body B over a step of `dt` (−it on A),
     /// given the joint's angle θ, the relative spin ω_B − ω_A and the pair's summed
-    /// inverse inertia. `implicit_share` β of the stiffness acts on the angle at the
-    /// step's end: a solver whose positions take the fraction p of the step's change of
-    /// velocity keeps an undamped spring's energy with β = 1 − p (0 where the kick comes
-    /// before the drift, as in symplectic Euler). A spring the step cannot resolve
-    /// ((ω h)² > 1) is wholly implicit.
-    pub(crate) fn impulse(
-        &self,
-        theta: f64,
-        relative_spin: f64,
-        inv_inertia: f64,
-        dt: f64,
-        implicit_share: f64,
-    ) -> f64 {
+    /// inverse inertia, as a kick before the drift: explicit in the stiffness where the
+    /// step resolves the spring ((ω h)² ≤ 1), so symplectic; implicit beyond (β = 1).
+    pub(crate) fn impulse(&self, theta: f64, relative_spin: f64, inv_inertia: f64, dt: f64) -> f64 {
         let (k, c, m) = (self.stiffness, self.damping, inv_inertia);
         if m <= 0.0 {
             return 0.0;
         }
-        let share = if dt * dt * k * m <= 1.0 {
-            implicit_share
-        } else {
-            1.0
-        };
+        let share = if dt * dt * k * m <= 1.0 { 0.0 } else { 1.0 };
         // ω' = ω + m·J with J = −dt·(k·(θ − rest + β·h·ω') + c·ω'), solved for ω'.
         let spin_after = (relative_spin - m * dt * k * (theta - self.rest_angle))
             / (1.0 + m * dt * (c + share * dt * k));

@@ -191,6 +191,13 @@ impl World {
             (0..self.joints.len() as u32)
                 .filter(|&k| self.joints[k as usize].is_some_and(|j| j.motor.is_some())),
         );
+        self.spring_joints.clear();
+        self.spring_joints
+            .extend((0..self.joints.len() as u32).filter(|&k| {
+                self.joints[k as usize]
+                    .as_ref()
+                    .is_some_and(|j| j.spring.is_some())
+            }));
         let pivot_sharers = self.pairs_sharing_a_pivot();
         self.non_colliding.rebuild(
             self.joints

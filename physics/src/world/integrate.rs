@@ -20,20 +20,18 @@ impl World {
         }
     }
 
-    /// Each joint spring's angular impulse over `dt` (`JointSpring::impulse`, with
-    /// `implicit_share`), handed to `apply` with each body this pass moves: + on body B,
-    /// − on body A.
-    fn joint_spring_impulses(
-        &mut self,
-        dt: f64,
-        implicit_share: f64,
-        mut apply: impl FnMut(&mut Body, f64),
-    ) {
-        for k in 0..self.joints.len() {
-            let Some(joint) = self.joints[k] else {
-                continue;
-            };
-            let Some(spring) = joint.spring else {
+    /// Joint springs change spins at once, before a (sub)step's velocities are
+    /// integrated: a kick before the drift, symplectic where the step resolves the spring
+    /// (`JointSpring::impulse`); + on body B, − on body A, of the bodies this pass moves.
+    pub(super) fn kick_joint_springs(&mut self, dt: f64) {
+        // Only the joints with a spring: a joint net's thousands of pins are not read
+        // every substep to find none.
+        for i in 0..self.spring_joints.len() {
+            let k = self.spring_joints[i] as usize;
+            let Some((spring, body_a, body_b)) = self.joints[k]
+                .as_ref()
+                .and_then(|j| Some((j.spring?, j.body_a, j.body_b)))
+            else {
                 continue;
             };
             let moving = |h: Option<crate::body::BodyHandle>| {
@@ -41,7 +39,7 @@ impl World {
                 let b = self.bodies.get(h.index())?.as_ref()?;
                 (!self.sets.fixed_in_pass(h.0, b)).then_some((b.angular_velocity, b.inv_inertia))
             };
-            let (a, b) = (moving(Some(joint.body_a)), moving(joint.body_b));
+            let (a, b) = (moving(Some(body_a)), moving(body_b));
             if a.is_none() && b.is_none() {
                 continue;
             }
@@ -50,33 +48,19 @@ impl World {
             };
             let spin = |side: Option<(f64, f64)>| side.map_or(0.0, |s| s.0);
             let inverse = |side: Option<(f64, f64)>| side.map_or(0.0, |s| s.1);
-            let impulse = spring.impulse(
-                theta,
-                spin(b) - spin(a),
-                inverse(a) + inverse(b),
-                dt,
-                implicit_share,
-            );
-            if a.is_some()
-                && let Some(Some(body)) = self.bodies.get_mut(joint.body_a.index())
-            {
-                apply(body, -impulse);
+            let impulse = spring.impulse(theta, spin(b) - spin(a), inverse(a) + inverse(b), dt);
+            let mut kick = |h: crate::body::BodyHandle, impulse: f64| {
+                if let Some(Some(body)) = self.bodies.get_mut(h.index()) {
+                    body.angular_velocity += impulse * body.inv_inertia;
+                }
+            };
+            if a.is_some() {
+                kick(body_a, -impulse);
             }
-            if b.is_some()
-                && let Some(h) = joint.body_b
-                && let Some(Some(body)) = self.bodies.get_mut(h.index())
-            {
-                apply(body, impulse);
+            if let (Some(_), Some(h)) = (b, body_b) {
+                kick(h, impulse);
             }
         }
-    }
-
-    /// Joint springs change spins at once, before a (sub)step's velocities are
-    /// integrated: a kick before the drift, symplectic (see `JointSpring::impulse`).
-    pub(super) fn kick_joint_springs(&mut self, dt: f64) {
-        self.joint_spring_impulses(dt, 0.0, |body, impulse| {
-            body.angular_velocity += impulse * body.inv_inertia;
-        });
     }
 
     /// Gravity and accumulated forces change velocities (thesis §3.4 steps 2–3).

@@ -221,6 +221,8 @@ pub struct World {
     jointed: Vec<u32>,
     /// The joints with a motor, by slot, increasing (made with `jointed`).
     motor_joints: Vec<u32>,
+    /// The joints with a spring, by slot, increasing (made with `jointed`).
+    spring_joints: Vec<u32>,
     /// The joints or ignored pairs changed since `non_colliding` and `jointed` were built:
     /// they are rebuilt once at the next step, not at every change (a sort per
     /// `add_joint` makes building a scene of many pins quadratic).
@@ -660,6 +662,9 @@ impl World {
             return Err(StepError::FallsTooFar { fall, limit });
         }
         self.check_motor_speeds(dt)?;
+        // The joint lists (motors, springs) as the joints are now, before anything reads
+        // them this step.
+        self.refresh_collision_filter();
         self.aim_servos(dt);
         if self.bodies_handed_out {
             self.check_bodies_given()?;
@@ -699,9 +704,11 @@ impl World {
 
     /// Each servo's speed for this step, from its joint's angle now.
     fn aim_servos(&mut self, dt: f64) {
-        for k in 0..self.joints.len() {
-            let servo =
-                self.joints[k].is_some_and(|j| j.motor.is_some_and(|m| m.target_angle.is_some()));
+        for i in 0..self.motor_joints.len() {
+            let k = self.motor_joints[i] as usize;
+            let servo = self.joints[k]
+                .as_ref()
+                .is_some_and(|j| j.motor.as_ref().is_some_and(|m| m.target_angle.is_some()));
             if !servo {
                 continue;
             }
